@@ -1,0 +1,111 @@
+#include "PointSets.hpp"
+
+#include "Errors.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace mpm {
+
+namespace {
+	template <class Field> void requireSize(const std::string& setName, const char* field, const Field& f, std::size_t n)
+	{
+		if (f.size() != n) {
+			std::ostringstream msg;
+			msg << setName << "." << field << " has " << f.size() << " entries but the set has " << n << " points (all arrays must have one entry per point)";
+			throw InvalidParameter(msg.str());
+		}
+	}
+	template <class T> bool allFinite(const T& x) { return x.allFinite(); }
+	inline bool             allFinite(Real x) { return std::isfinite(x); }
+
+	template <class Field> void requireFinite(const std::string& setName, const char* field, const Field& f)
+	{
+		for (std::size_t i = 0; i < f.size(); ++i)
+			if (!allFinite(f[i])) {
+				std::ostringstream msg;
+				msg << setName << "." << field << "[" << i << "] is not finite";
+				throw InvalidParameter(msg.str());
+			}
+	}
+	void requirePositive(const std::string& setName, const char* field, const std::vector<Real>& f, const char* unit)
+	{
+		for (std::size_t i = 0; i < f.size(); ++i)
+			if (!(f[i] > 0)) throwOutOfRange(setName + "." + field + "[" + std::to_string(i) + "]", f[i], unit, "(0, inf)");
+	}
+	void requirePorosity(const std::string& setName, const std::vector<Real>& f, bool allowOne)
+	{
+		for (std::size_t i = 0; i < f.size(); ++i)
+			if (!(f[i] > 0 && (allowOne ? f[i] <= 1 : f[i] < 1)))
+				throwOutOfRange(setName + ".porosity[" + std::to_string(i) + "]", f[i], "", allowOne ? "(0, 1]" : "(0, 1)");
+	}
+} // namespace
+
+void MaterialPointSet::resizeCommon(std::size_t n)
+{
+	position.resize(n, Vec3::Zero());
+	velocity.resize(n, Vec3::Zero());
+	mass.resize(n, 0);
+	volume.resize(n, 0);
+	halfLength.resize(n, Vec3::Zero());
+}
+
+void MaterialPointSet::validate(const std::string& setName) const
+{
+	const std::size_t n = size();
+	requireSize(setName, "velocity", velocity, n);
+	requireSize(setName, "mass", mass, n);
+	requireSize(setName, "volume", volume, n);
+	requireSize(setName, "halfLength", halfLength, n);
+	requireFinite(setName, "position", position);
+	requireFinite(setName, "velocity", velocity);
+	requirePositive(setName, "mass", mass, "kg");
+	requirePositive(setName, "volume", volume, "m³");
+	for (std::size_t i = 0; i < n; ++i)
+		if (!(halfLength[i].minCoeff() >= 0) || !halfLength[i].allFinite())
+			throwOutOfRange(setName + ".halfLength[" + std::to_string(i) + "]", halfLength[i].minCoeff(), "m", "[0, inf) in every component");
+}
+
+void SolidPointSet::resize(std::size_t n)
+{
+	resizeCommon(n);
+	initialVolume.resize(n, 0);
+	initialHalfLength.resize(n, Vec3::Zero());
+	deformationGradient.resize(n, Mat3::Identity());
+	effectiveStress.resize(n, Voigt6::Zero());
+	porosity.resize(n, 0);
+}
+
+void SolidPointSet::validate(const std::string& setName) const
+{
+	MaterialPointSet::validate(setName);
+	const std::size_t n = size();
+	requireSize(setName, "initialVolume", initialVolume, n);
+	requireSize(setName, "initialHalfLength", initialHalfLength, n);
+	requireSize(setName, "deformationGradient", deformationGradient, n);
+	requireSize(setName, "effectiveStress", effectiveStress, n);
+	requireSize(setName, "porosity", porosity, n);
+	requirePositive(setName, "initialVolume", initialVolume, "m³");
+	requireFinite(setName, "deformationGradient", deformationGradient);
+	requireFinite(setName, "effectiveStress", effectiveStress);
+	requirePorosity(setName, porosity, false);
+}
+
+void WaterPointSet::resize(std::size_t n)
+{
+	resizeCommon(n);
+	porePressure.resize(n, 0);
+	porosity.resize(n, 1);
+}
+
+void WaterPointSet::validate(const std::string& setName) const
+{
+	MaterialPointSet::validate(setName);
+	const std::size_t n = size();
+	requireSize(setName, "porePressure", porePressure, n);
+	requireSize(setName, "porosity", porosity, n);
+	requireFinite(setName, "porePressure", porePressure);
+	requirePorosity(setName, porosity, true);
+}
+
+} // namespace mpm

@@ -1,0 +1,50 @@
+// Material point sets in structure-of-arrays form: one contiguous array per field, so that the
+// stages stream through memory and OpenMP splits them by index (doc/theory.md §2.1).
+#pragma once
+
+#include "Types.hpp"
+
+#include <string>
+#include <vector>
+
+namespace mpm {
+
+// Fields every material point carries, whatever its phase.
+struct MaterialPointSet {
+	std::vector<Vec3> position;   // x_p [m]
+	std::vector<Vec3> velocity;   // v_p [m s⁻¹]
+	std::vector<Real> mass;       // m_p [kg], constant over a run
+	std::vector<Real> volume;     // V_p [m³], current mixture volume represented by the point
+	std::vector<Vec3> halfLength; // l_p [m], GIMP half-size of the point's domain per axis
+
+	std::size_t size() const { return position.size(); }
+	// Check that every field has size() entries and holds finite, admissible values; throws
+	// InvalidParameter naming the set, field, point index and value.
+	void validate(const std::string& setName) const;
+
+protected:
+	void resizeCommon(std::size_t n);
+};
+
+// Solid skeleton points: carry the effective stress and the porosity of the mixture.
+struct SolidPointSet : MaterialPointSet {
+	std::vector<Real>   initialVolume;       // V0_p [m³]
+	std::vector<Vec3>   initialHalfLength;   // l0_p [m], reference for cpGIMP
+	std::vector<Mat3>   deformationGradient; // F_p [-]
+	std::vector<Voigt6> effectiveStress;     // σ′_p [Pa], tension-positive, Voigt order
+	std::vector<Real>   porosity;            // n_p [-]
+
+	void resize(std::size_t n);
+	void validate(const std::string& setName) const;
+};
+
+// Pore-water points: carry the pore pressure; their porosity is interpolated from the solid.
+struct WaterPointSet : MaterialPointSet {
+	std::vector<Real> porePressure; // p_p [Pa], compression-positive
+	std::vector<Real> porosity;     // n_p [-], 1 for free water
+
+	void resize(std::size_t n);
+	void validate(const std::string& setName) const;
+};
+
+} // namespace mpm

@@ -1,0 +1,38 @@
+// Basic types and the sign/unit conventions of the numerical core (doc/conventions.md).
+//
+// Units: SI throughout (m, kg, s, Pa).
+// Signs: stress is tension-positive; pore pressure is compression-positive; effective stress
+//        principle σ = σ′ − p I (incompressible grains, Biot coefficient 1).
+// Voigt order for symmetric tensors: (xx, yy, zz, xy, yz, zx).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstddef>
+
+namespace mpm {
+
+using Real   = double;
+using Vec3   = Eigen::Matrix<Real, 3, 1>;
+using Mat3   = Eigen::Matrix<Real, 3, 3>;
+using Voigt6 = Eigen::Matrix<Real, 6, 1>; // (xx, yy, zz, xy, yz, zx)
+
+enum class Phase { Solid, Water };
+
+enum class VoigtIndex : int { XX = 0, YY = 1, ZZ = 2, XY = 3, YZ = 4, ZX = 5 };
+
+inline Mat3 voigtToMatrix(const Voigt6& s)
+{
+	Mat3 m;
+	m << s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2];
+	return m;
+}
+
+inline Voigt6 matrixToVoigt(const Mat3& m)
+{
+	Voigt6 s;
+	s << m(0, 0), m(1, 1), m(2, 2), 0.5 * (m(0, 1) + m(1, 0)), 0.5 * (m(1, 2) + m(2, 1)), 0.5 * (m(2, 0) + m(0, 2));
+	return s;
+}
+
+} // namespace mpm

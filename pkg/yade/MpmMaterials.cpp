@@ -1,0 +1,111 @@
+#include "MpmMaterials.hpp"
+
+#include "Serialization.hpp"
+
+#include "../core/Errors.hpp"
+
+namespace yade_mpm {
+
+MpmSoilMat::~MpmSoilMat()   = default;
+MpmWaterMat::~MpmWaterMat() = default;
+
+mpm::SoilParameters MpmSoilMat::parameters() const
+{
+	mpm::SoilParameters p;
+	p.density               = density;
+	p.youngModulus          = youngModulus;
+	p.poissonRatio          = poissonRatio;
+	p.porosity              = porosity;
+	p.intrinsicPermeability = intrinsicPermeability;
+	p.validate();
+	return p;
+}
+
+mpm::WaterParameters MpmWaterMat::parameters() const
+{
+	mpm::WaterParameters p;
+	p.density     = density;
+	p.bulkModulus = bulkModulus;
+	p.viscosity   = viscosity;
+	p.validate();
+	return p;
+}
+
+// Validate on every change from Python, so a bad value is reported where it is set.
+void MpmSoilMat::callPostLoad()
+{
+	yade::Material::callPostLoad();
+	try {
+		parameters();
+	} catch (const mpm::InvalidParameter& e) {
+		raisePython(PyExc_ValueError, "MpmSoilMat: " + std::string(e.what()));
+	}
+}
+
+void MpmWaterMat::callPostLoad()
+{
+	yade::Material::callPostLoad();
+	try {
+		parameters();
+	} catch (const mpm::InvalidParameter& e) {
+		raisePython(PyExc_ValueError, "MpmWaterMat: " + std::string(e.what()));
+	}
+}
+
+const AttrTable<MpmSoilMat>& MpmSoilMat::attributes()
+{
+	using M = MpmSoilMat;
+	static const AttrTable<M> table {
+		realAttr("youngModulus", &M::youngModulus, "Young's modulus E of the drained skeleton [Pa], > 0"),
+		realAttr("poissonRatio", &M::poissonRatio, "Poisson's ratio ν of the drained skeleton [-], in (-1, 0.5)"),
+		realAttr("porosity", &M::porosity, "Initial porosity n0 [-], in (0, 1)"),
+		realAttr("intrinsicPermeability", &M::intrinsicPermeability,
+		         "Intrinsic permeability κ [m²], > 0; the hydraulic conductivity is k = κ ρw |g| / μw [m s⁻¹] with the engine's gravity"),
+	};
+	return table;
+}
+
+const AttrTable<MpmWaterMat>& MpmWaterMat::attributes()
+{
+	using M = MpmWaterMat;
+	static const AttrTable<M> table {
+		realAttr("bulkModulus", &M::bulkModulus, "Bulk modulus of the pore water Kw [Pa], > 0 (2.2e9 for water; lower it only with Kw/n ≫ E_oed)"),
+		realAttr("viscosity", &M::viscosity, "Dynamic viscosity of the pore water μw [Pa s], > 0"),
+	};
+	return table;
+}
+
+void MpmSoilMat::pyRegisterClass(py::object scope)
+{
+	registerPythonClass<MpmSoilMat, yade::Material>(
+	        scope, "Soil skeleton of the two-phase MPM. density is the intrinsic grain density ρs [kg m⁻³]; the skeleton is linear elastic (E, ν) with initial porosity n0 and intrinsic permeability κ.");
+}
+
+void MpmWaterMat::pyRegisterClass(py::object scope)
+{
+	registerPythonClass<MpmWaterMat, yade::Material>(
+	        scope, "Pore water of the two-phase MPM. density is the intrinsic water density ρw [kg m⁻³]; the water is linearly compressible (Kw) with viscosity μw.");
+}
+
+template <class Archive> void MpmSoilMat::serialize(Archive& ar, unsigned int)
+{
+	ar& boost::serialization::make_nvp("Material", boost::serialization::base_object<yade::Material>(*this));
+	ar& BOOST_SERIALIZATION_NVP(youngModulus);
+	ar& BOOST_SERIALIZATION_NVP(poissonRatio);
+	ar& BOOST_SERIALIZATION_NVP(porosity);
+	ar& BOOST_SERIALIZATION_NVP(intrinsicPermeability);
+}
+
+template <class Archive> void MpmWaterMat::serialize(Archive& ar, unsigned int)
+{
+	ar& boost::serialization::make_nvp("Material", boost::serialization::base_object<yade::Material>(*this));
+	ar& BOOST_SERIALIZATION_NVP(bulkModulus);
+	ar& BOOST_SERIALIZATION_NVP(viscosity);
+}
+
+} // namespace yade_mpm
+
+BOOST_CLASS_EXPORT_KEY2(yade_mpm::MpmSoilMat, "MpmSoilMat")
+BOOST_CLASS_EXPORT_KEY2(yade_mpm::MpmWaterMat, "MpmWaterMat")
+BOOST_CLASS_EXPORT_IMPLEMENT(yade_mpm::MpmSoilMat)
+BOOST_CLASS_EXPORT_IMPLEMENT(yade_mpm::MpmWaterMat)

@@ -1,0 +1,95 @@
+#include "MpmPointShapes.hpp"
+
+#include "PointFieldAttributes.hpp"
+#include "Serialization.hpp"
+
+namespace yade_mpm {
+
+using mpm::SolidPointSet;
+using mpm::WaterPointSet;
+
+MpmSolidPoints::~MpmSolidPoints() = default;
+MpmWaterPoints::~MpmWaterPoints() = default;
+
+const AttrTable<MpmSolidPoints>& MpmSolidPoints::attributes()
+{
+	using S = MpmSolidPoints;
+	static const AttrTable<S> table {
+		pointArrayAttr(
+		        "pos", &S::points, &SolidPointSet::position, "Positions of the solid points, shape (N, 3) [m]. Assigning it sets the number of points N.", true),
+		pointArrayAttr("vel", &S::points, &SolidPointSet::velocity, "Velocities of the solid points v_s, shape (N, 3) [m s⁻¹]"),
+		pointArrayAttr("mass", &S::points, &SolidPointSet::mass, "Solid mass of each point m_sp = (1−n0) ρs V0, shape (N,) [kg]"),
+		pointArrayAttr("volume", &S::points, &SolidPointSet::volume, "Current mixture volume of each point V_sp, shape (N,) [m³]"),
+		pointArrayAttr("initialVolume", &S::points, &SolidPointSet::initialVolume, "Initial mixture volume of each point V0, shape (N,) [m³]"),
+		pointArrayAttr("halfLength", &S::points, &SolidPointSet::halfLength, "GIMP half-lengths of each point's domain l_p, shape (N, 3) [m]"),
+		pointArrayAttr("initialHalfLength", &S::points, &SolidPointSet::initialHalfLength, "Initial GIMP half-lengths l0_p, shape (N, 3) [m]"),
+		pointArrayAttr("defGrad", &S::points, &SolidPointSet::deformationGradient, "Deformation gradient F of each point, shape (N, 3, 3) [-]"),
+		pointArrayAttr("stress", &S::points, &SolidPointSet::effectiveStress, "Effective stress σ′ (tension-positive), symmetric, shape (N, 3, 3) [Pa]"),
+		pointArrayAttr("porosity", &S::points, &SolidPointSet::porosity, "Porosity n of the mixture at each solid point, shape (N,) [-]"),
+		readOnly(AttrSpec<S> { "count", "Number of points N [-]", [](const S& s) { return py::object(s.points.size()); }, nullptr }),
+	};
+	return table;
+}
+
+const AttrTable<MpmWaterPoints>& MpmWaterPoints::attributes()
+{
+	using W = MpmWaterPoints;
+	static const AttrTable<W> table {
+		pointArrayAttr(
+		        "pos", &W::points, &WaterPointSet::position, "Positions of the water points, shape (N, 3) [m]. Assigning it sets the number of points N.", true),
+		pointArrayAttr("vel", &W::points, &WaterPointSet::velocity, "Velocities of the water points v_w, shape (N, 3) [m s⁻¹]"),
+		pointArrayAttr("mass", &W::points, &WaterPointSet::mass, "Water mass of each point m_wp = n0 ρw V0, shape (N,) [kg]"),
+		pointArrayAttr("volume", &W::points, &WaterPointSet::volume, "Current mixture volume attached to each point V_wp, shape (N,) [m³]"),
+		pointArrayAttr("halfLength", &W::points, &WaterPointSet::halfLength, "GIMP half-lengths of each point's domain l_p, shape (N, 3) [m]"),
+		pointArrayAttr("porePressure", &W::points, &WaterPointSet::porePressure, "Pore-water pressure p (compression-positive), shape (N,) [Pa]"),
+		pointArrayAttr("porosity", &W::points, &WaterPointSet::porosity, "Porosity n interpolated at each water point (1 for free water), shape (N,) [-]"),
+		readOnly(AttrSpec<W> { "count", "Number of points N [-]", [](const W& s) { return py::object(s.points.size()); }, nullptr }),
+	};
+	return table;
+}
+
+void MpmSolidPoints::pyRegisterClass(py::object scope)
+{
+	registerPythonClass<MpmSolidPoints, yade::Shape>(
+	        scope, "The solid (skeleton) material points of one body: positions, velocities, masses, volumes, GIMP domains, deformation gradients, effective stresses and porosities, stored as one array per field.");
+}
+
+void MpmWaterPoints::pyRegisterClass(py::object scope)
+{
+	registerPythonClass<MpmWaterPoints, yade::Shape>(
+	        scope, "The pore-water material points of one body: positions, velocities, masses, volumes, GIMP domains, pore pressures and porosities, stored as one array per field.");
+}
+
+template <class Archive> void MpmSolidPoints::serialize(Archive& ar, unsigned int)
+{
+	ar& boost::serialization::make_nvp("Shape", boost::serialization::base_object<yade::Shape>(*this));
+	serializeFlat(ar, "position", points.position);
+	serializeFlat(ar, "velocity", points.velocity);
+	serializeFlat(ar, "mass", points.mass);
+	serializeFlat(ar, "volume", points.volume);
+	serializeFlat(ar, "halfLength", points.halfLength);
+	serializeFlat(ar, "initialVolume", points.initialVolume);
+	serializeFlat(ar, "initialHalfLength", points.initialHalfLength);
+	serializeFlat(ar, "deformationGradient", points.deformationGradient);
+	serializeFlat(ar, "effectiveStress", points.effectiveStress);
+	serializeFlat(ar, "porosity", points.porosity);
+}
+
+template <class Archive> void MpmWaterPoints::serialize(Archive& ar, unsigned int)
+{
+	ar& boost::serialization::make_nvp("Shape", boost::serialization::base_object<yade::Shape>(*this));
+	serializeFlat(ar, "position", points.position);
+	serializeFlat(ar, "velocity", points.velocity);
+	serializeFlat(ar, "mass", points.mass);
+	serializeFlat(ar, "volume", points.volume);
+	serializeFlat(ar, "halfLength", points.halfLength);
+	serializeFlat(ar, "porePressure", points.porePressure);
+	serializeFlat(ar, "porosity", points.porosity);
+}
+
+} // namespace yade_mpm
+
+BOOST_CLASS_EXPORT_KEY2(yade_mpm::MpmSolidPoints, "MpmSolidPoints")
+BOOST_CLASS_EXPORT_KEY2(yade_mpm::MpmWaterPoints, "MpmWaterPoints")
+BOOST_CLASS_EXPORT_IMPLEMENT(yade_mpm::MpmSolidPoints)
+BOOST_CLASS_EXPORT_IMPLEMENT(yade_mpm::MpmWaterPoints)

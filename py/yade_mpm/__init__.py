@@ -1,0 +1,39 @@
+"""yade_mpm: fully coupled two-phase (solid + pore water) material point method for YADE.
+
+Import it in a ``yade-double`` script, or in Debian's ``/usr/bin/python3`` (alone or after
+``from yade import *``). Importing checks that the running YADE is the one the compiled binding
+was built for, then registers the classes ``MpmTwoPhaseEngine``, ``MpmSolidPoints``,
+``MpmWaterPoints``, ``MpmSoilMat`` and ``MpmWaterMat`` in ``yade.wrapper`` and builtins.
+"""
+import os
+import sys
+
+_YADE_PY_DIR = "/usr/lib/x86_64-linux-gnu/yade-double/py"
+
+if "yade" not in sys.modules:
+    try:
+        import yade  # noqa: F401  (boots YADE)
+    except ImportError:
+        # Debian's dist-packages/yade link points to a directory yade-double does not use.
+        if os.path.isdir(_YADE_PY_DIR) and _YADE_PY_DIR not in sys.path:
+            sys.path.insert(1, _YADE_PY_DIR)
+        import yade  # noqa: F401
+
+import yade
+import yade.config
+import yade.wrapper
+
+from . import _buildinfo
+from ._guard import YadeAbiMismatch, check_compatibility, self_test
+
+check_compatibility(yade.config, _buildinfo)
+
+from . import _yade_mpm  # noqa: E402  (only after the guard: loading it trusts the layout)
+
+_yade_mpm.registerClasses(yade.wrapper)
+self_test(_yade_mpm, yade.wrapper, yade.wrapper.Omega())
+
+from yade.wrapper import MpmSoilMat, MpmSolidPoints, MpmTwoPhaseEngine, MpmWaterMat, MpmWaterPoints  # noqa: E402
+
+__version__ = _buildinfo.package_version
+__all__ = ["MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat", "YadeAbiMismatch"]
