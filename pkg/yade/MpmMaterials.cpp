@@ -56,6 +56,7 @@ const AttrTable<MpmSoilMat>& MpmSoilMat::attributes()
 {
 	using M = MpmSoilMat;
 	static const AttrTable<M> table {
+		realAttr("density", static_cast<yade::Real M::*>(&M::density), "Intrinsic density of the grains ρs [kg m⁻³], > 0"),
 		realAttr("youngModulus", &M::youngModulus, "Young's modulus E of the drained skeleton [Pa], > 0"),
 		realAttr("poissonRatio", &M::poissonRatio, "Poisson's ratio ν of the drained skeleton [-], in (-1, 0.5)"),
 		realAttr("porosity", &M::porosity, "Initial porosity n0 [-], in (0, 1)"),
@@ -69,6 +70,7 @@ const AttrTable<MpmWaterMat>& MpmWaterMat::attributes()
 {
 	using M = MpmWaterMat;
 	static const AttrTable<M> table {
+		realAttr("density", static_cast<yade::Real M::*>(&M::density), "Intrinsic density of the pore water ρw [kg m⁻³], > 0"),
 		realAttr("bulkModulus", &M::bulkModulus, "Bulk modulus of the pore water Kw [Pa], > 0 (2.2e9 for water; lower it only with Kw/n ≫ E_oed)"),
 		realAttr("viscosity", &M::viscosity, "Dynamic viscosity of the pore water μw [Pa s], > 0"),
 	};

@@ -53,8 +53,8 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 	using E = MpmTwoPhaseEngine;
 	static const AttrTable<E> table {
 		vector3Attr("gravity", &E::gravity, "Gravitational acceleration acting on both phases b [m s⁻²]"),
-		realAttr("timeStepFactor", &E::timeStepFactor, "Safety factor C on the critical time step [-], in (0, 1]"),
-		realAttr("flipBlend", &E::flipBlend, "FLIP/PIC blend α of the grid-to-point velocity update [-], in [0, 1] (1 = pure FLIP)"),
+		realAttr("timeStepFactor", &E::timeStepFactor, "Safety factor C on the critical time step [-], 0 < C ≤ 1"),
+		realAttr("flipBlend", &E::flipBlend, "FLIP/PIC blend α of the grid-to-point velocity update [-], 0 ≤ α ≤ 1 (1 = pure FLIP, 0 = PIC)"),
 		readOnly(intAttr("stepsDone", &E::stepsDone, "Number of times the engine ran [-]")),
 		readOnly(realAttr("mpmTime", &E::mpmTime, "Total time the MPM state was advanced [s]")),
 		readOnly(intAttr("lastIter", &E::lastIter, "O.iter seen by the last run of the engine [-]")),

@@ -90,7 +90,15 @@ template <class T> boost::shared_ptr<T> constructWithKeywords(py::tuple args, py
 {
 	auto obj = boost::shared_ptr<T>(new T);
 	if (py::len(args) > 0) raisePython(PyExc_TypeError, obj->getClassName() + " takes keyword arguments only");
-	obj->pyUpdateAttrs(kw);
+	// Apply keywords in table order (e.g. 'pos', which sets the number of points, before the
+	// other arrays), whatever order the user wrote them in; the rest (YADE's own) afterwards.
+	py::dict ordered;
+	for (const auto& spec : T::attributes())
+		if (kw.has_key(spec.name)) ordered[spec.name] = kw[spec.name];
+	py::list keys = kw.keys();
+	for (long i = 0; i < py::len(keys); ++i)
+		if (!ordered.has_key(keys[i])) ordered[keys[i]] = kw[keys[i]];
+	obj->pyUpdateAttrs(ordered);
 	return obj;
 }
 

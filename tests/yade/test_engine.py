@@ -1,0 +1,80 @@
+"""MpmTwoPhaseEngine runs inside O.engines once per step and sees the scene's dt, time and iter."""
+import numpy as np
+import pytest
+
+import yade.wrapper as w
+from yade import O
+
+import yade_mpm
+
+
+def test_runs_once_per_step_and_sees_dt_time_iter():
+    seen = []
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm"),
+                 w.PyRunner(command="seen.append((mpm.lastIter, mpm.lastDt, O.iter, O.time, O.dt))", iterPeriod=1, initRun=True)]
+    import builtins
+    builtins.seen = seen
+    try:
+        O.dt = 1e-3
+        O.run(4, True)
+        O.dt = 2.5e-4  # a changed step is seen at the next step
+        O.run(3, True)
+    finally:
+        del builtins.seen
+    engine = O.engines[0]
+    assert engine.stepsDone == 7 == O.iter
+    for last_iter, last_dt, iteration, time, dt in seen:
+        # engines run before O.iter and O.time advance at the end of the step
+        assert last_iter == iteration and last_dt == dt
+    assert [s[0] for s in seen] == list(range(7))
+    assert engine.mpmTime == pytest.approx(O.time, rel=1e-15)
+    assert engine.mpmTime == pytest.approx(4 * 1e-3 + 3 * 2.5e-4, rel=1e-15)
+
+
+def test_dead_engine_does_not_run():
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm", dead=True)]
+    O.run(3, True)
+    assert O.engines[0].stepsDone == 0
+
+
+def test_counts_points_of_all_mpm_bodies_and_ignores_others():
+    soil, water = w.MpmSoilMat(), w.MpmWaterMat()
+    O.materials.append([soil, water])
+    solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (0.2, 0.1, 0.1), 0.05, soil, water, points_per_cell=2)
+    O.bodies.append([solid_body, water_body, w.Body(shape=w.Sphere(radius=1))])
+    O.bodies.erase(O.bodies.append(w.Body()))  # an erased slot must be skipped
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm")]
+    O.step()
+    assert O.engines[0].solidPointCount == 4 * 2 * 2 * 8
+    assert O.engines[0].waterPointCount == 4 * 2 * 2 * 8
+
+
+def test_bad_point_data_stops_before_any_work_with_a_clear_message():
+    solid = w.MpmSolidPoints(pos=np.zeros((3, 3)))
+    solid.mass = np.array([1.0, np.nan, 1.0])
+    O.bodies.append(w.Body(shape=solid))
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm")]
+    with pytest.raises(ValueError, match=r"O.bodies\[0\].shape.mass\[1\] = nan kg is outside the valid range"):
+        O.step()
+    assert O.engines[0].stepsDone == 0 and O.engines[0].mpmTime == 0
+
+
+def test_saturated_block_geostatic_state():
+    """Pore pressure ρw g d and vertical effective stress −(ρsat−ρw) g d at depth d; masses exact."""
+    g = 9.81
+    soil = w.MpmSoilMat(density=2650, porosity=0.4, poissonRatio=0.25)
+    water = w.MpmWaterMat(density=1000)
+    solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (0.1, 0.1, 1.0), 0.1, soil, water, points_per_cell=2, gravity=(0, 0, -g))
+    s, f = solid_body.shape, water_body.shape
+    depth = 1.0 - s.pos[:, 2]
+    rho_sat = 0.6 * 2650 + 0.4 * 1000
+    assert np.allclose(f.porePressure, 1000 * g * depth, rtol=1e-14)
+    assert np.allclose(s.stress[:, 2, 2], -(rho_sat - 1000) * g * depth, rtol=1e-14)
+    assert np.allclose(s.stress[:, 0, 0], 0.25 / 0.75 * s.stress[:, 2, 2], rtol=1e-14)  # K0 = ν/(1−ν)
+    assert s.mass.sum() == pytest.approx(0.6 * 2650 * 0.01, rel=1e-14)
+    assert f.mass.sum() == pytest.approx(0.4 * 1000 * 0.01, rel=1e-14)
+    assert np.allclose(s.halfLength, 0.025)
+    with pytest.raises(ValueError, match="whole, positive number of cells"):
+        yade_mpm.saturated_block((0, 0, 0), (0.15, 0.1, 1.0), 0.1, soil, water)
+    with pytest.raises(ValueError, match="must point along −z"):
+        yade_mpm.saturated_block((0, 0, 0), (0.1, 0.1, 1.0), 0.1, soil, water, gravity=(1, 0, 0))
