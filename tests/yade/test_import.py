@@ -68,3 +68,21 @@ def test_import_is_idempotent_and_scene_untouched(tmp_path):
         print("STATE", O.dt, len(O.bodies))
     """, tmp_path)
     assert "STATE 0.125 0" in result.stdout, result.stdout + result.stderr
+
+
+def test_boot_time_route_registers_with_yade_class_factory(tmp_path):
+    """With YADE_PREFIX pointing at the installed prefix, YADE loads the plugin at boot: the classes
+    are YADE plugin classes (O.childClassesNonrecursive, O.isChildClassOf), and a later
+    `import yade_mpm` (guard and self-test) finds them already registered."""
+    env = env_without_build_tree()
+    env["YADE_PREFIX"] = "/usr/local/lib/yade-mpm/yade-prefix"
+    result = run_script("""
+        print("BOOT", "MpmTwoPhaseEngine" in O.childClassesNonrecursive("GlobalEngine"),
+              O.isChildClassOf("MpmSolidPoints", "Shape"), O.isChildClassOf("MpmWaterMat", "Material"))
+        import yade_mpm
+        O.engines = [MpmTwoPhaseEngine(label="mpm")]
+        O.run(2, True)
+        print("RAN", mpm.stepsDone, yade_mpm.MpmTwoPhaseEngine is yade.wrapper.MpmTwoPhaseEngine)
+    """, tmp_path, interpreter=YADE, env=env)
+    assert "BOOT True True True" in result.stdout, result.stdout + result.stderr
+    assert "RAN 2 True" in result.stdout
