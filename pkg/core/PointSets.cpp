@@ -74,6 +74,7 @@ void SolidPointSet::resize(std::size_t n)
 	deformationGradient.resize(n, Mat3::Identity());
 	effectiveStress.resize(n, Voigt6::Zero());
 	porosity.resize(n, 0);
+	externalForce.resize(n, Vec3::Zero());
 }
 
 void SolidPointSet::validate(const std::string& setName) const
@@ -85,7 +86,9 @@ void SolidPointSet::validate(const std::string& setName) const
 	requireSize(setName, "deformationGradient", deformationGradient, n);
 	requireSize(setName, "effectiveStress", effectiveStress, n);
 	requireSize(setName, "porosity", porosity, n);
+	requireSize(setName, "externalForce", externalForce, n);
 	requirePositive(setName, "initialVolume", initialVolume, "m³");
+	requireFinite(setName, "externalForce", externalForce);
 	requireFinite(setName, "deformationGradient", deformationGradient);
 	requireFinite(setName, "effectiveStress", effectiveStress);
 	requirePorosity(setName, porosity, false);

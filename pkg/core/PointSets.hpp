@@ -33,6 +33,7 @@ struct SolidPointSet : MaterialPointSet {
 	std::vector<Mat3>   deformationGradient; // F_p [-]
 	std::vector<Voigt6> effectiveStress;     // σ′_p [Pa], tension-positive, Voigt order
 	std::vector<Real>   porosity;            // n_p [-]
+	std::vector<Vec3>   externalForce;       // prescribed point load, e.g. a surface traction × area [N]
 
 	void resize(std::size_t n);
 	void validate(const std::string& setName) const;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU> // determinant()
 
 #include <cstddef>
 

@@ -1,0 +1,50 @@
+// Boundary conditions per phase on the walls of the domain box (doc/theory.md §2.3). Walls lie on
+// the grid's node planes at the box faces; a condition applies to the wall plane and to the
+// padding nodes beyond it.
+#pragma once
+
+#include "Grid.hpp"
+
+#include <array>
+
+namespace mpm {
+
+enum class SolidWall {
+	Free,  // no constraint
+	Slip,  // smooth (roller) wall: normal solid velocity 0
+	Fixed, // rough rigid wall: all solid velocity components 0
+};
+
+enum class WaterWall {
+	Free,        // no condition on the water (natural: zero pressure traction, weakly enforced)
+	Impermeable, // normal water velocity 0 (tangential water flow free)
+	Drained,     // water crosses freely; pore pressure held at drainedPressure on the water
+	             // points whose GIMP domain reaches the face or lies beyond it (theory.md §2.3)
+};
+
+struct WallConditions {
+	SolidWall solid           = SolidWall::Free;
+	WaterWall water           = WaterWall::Free;
+	Real      drainedPressure = 0; // p̄ [Pa] on a Drained face
+};
+
+// One entry per Face (XMin, XMax, YMin, YMax, ZMin, ZMax).
+struct BoundaryConditions {
+	std::array<WallConditions, faceCount> walls {};
+};
+
+// Which velocity components are held at zero at one node, per phase.
+struct NodeConstraint {
+	std::array<bool, 3> solid { false, false, false };
+	std::array<bool, 3> water { false, false, false };
+	bool                any() const { return solid[0] || solid[1] || solid[2] || water[0] || water[1] || water[2]; }
+};
+
+// Constraint of node (i, j, k) under the given walls.
+NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& bcs, int i, int j, int k);
+
+struct WaterPointSet;
+// Hold the pore pressure of water points at Drained faces (theory.md §2.3, eq. 2.1).
+void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, WaterPointSet& points);
+
+} // namespace mpm

@@ -1,0 +1,83 @@
+// Regular Cartesian background grid and its nodal fields (doc/theory.md §2.2).
+#pragma once
+
+#include "Types.hpp"
+
+#include <array>
+#include <vector>
+
+namespace mpm {
+
+// Faces of the domain box, in this order wherever faces are indexed.
+enum class Face { XMin = 0, XMax = 1, YMin = 2, YMax = 3, ZMin = 4, ZMax = 5 };
+constexpr int faceCount = 6;
+
+// The grid covers the domain box [lower, upper] plus one padding cell on every side, so that
+// GIMP supports (reach h + l_p) of points inside the box always find their nodes.
+struct GridGeometry {
+	Vec3               origin;   // position of node (0, 0, 0) [m]
+	Real               cellSize; // h [m]
+	std::array<int, 3> nodes;    // node count per axis
+	std::array<int, 3> wallNode; // index of the node plane of the lower walls (1)
+	std::array<int, 3> upperWallNode;
+
+	static GridGeometry forDomain(const Vec3& lower, const Vec3& upper, Real cellSize);
+	std::size_t         nodeCount() const { return static_cast<std::size_t>(nodes[0]) * nodes[1] * nodes[2]; }
+	std::size_t         index(int i, int j, int k) const { return static_cast<std::size_t>(i) + nodes[0] * (static_cast<std::size_t>(j) + static_cast<std::size_t>(nodes[1]) * k); }
+	Vec3                nodePosition(int i, int j, int k) const { return origin + cellSize * Vec3(i, j, k); }
+	Vec3                lower() const { return nodePosition(wallNode[0], wallNode[1], wallNode[2]); }
+	Vec3                upper() const { return nodePosition(upperWallNode[0], upperWallNode[1], upperWallNode[2]); }
+};
+
+// Nodal quantities mapped from the solid points.
+struct SolidNode {
+	Real mass;         // m^s_I [kg]
+	Vec3 momentum;     // P^s_I [kg m s⁻¹]
+	Vec3 mixtureForce; // f^m_I: effective stress, solid weight and point loads; pressure and water weight added later [N]
+	Real volume;       // V_I = Σ S V_sp, mixture volume [m³]
+	Real solidVolume;  // Σ S m_sp/ρs, grain volume [m³]
+	Real drag;         // Q_I = Σ S V_sp n² μw/κ [kg s⁻¹]
+};
+
+// Nodal quantities mapped from the water points.
+struct WaterNode {
+	Real mass;          // m^w_I [kg]
+	Vec3 momentum;      // P^w_I [kg m s⁻¹]
+	Vec3 weight;        // Σ S m_wp b [N]
+	Vec3 porousForce;   // Σ V_wp p (n ∇S + S ∇n), the −n∇p force on the water [N]
+	Vec3 pressureForce; // f^p_I = Σ V_wp p ∇S, pore-pressure part of the mixture force [N]
+};
+
+inline SolidNode& operator+=(SolidNode& a, const SolidNode& b)
+{
+	a.mass += b.mass;
+	a.momentum += b.momentum;
+	a.mixtureForce += b.mixtureForce;
+	a.volume += b.volume;
+	a.solidVolume += b.solidVolume;
+	a.drag += b.drag;
+	return a;
+}
+inline WaterNode& operator+=(WaterNode& a, const WaterNode& b)
+{
+	a.mass += b.mass;
+	a.momentum += b.momentum;
+	a.weight += b.weight;
+	a.porousForce += b.porousForce;
+	a.pressureForce += b.pressureForce;
+	return a;
+}
+
+struct GridFields {
+	std::vector<SolidNode> solid;
+	std::vector<WaterNode> water;
+	std::vector<Real>      porosity;         // n_I = 1 − (grain volume)/(mixture volume) [-]
+	std::vector<Vec3>      solidVelocity;    // v^s_I at t^n [m s⁻¹]
+	std::vector<Vec3>      waterVelocity;    // v^w_I at t^n [m s⁻¹]
+	std::vector<Vec3>      solidVelocityNew; // v^s_I at t^{n+1}, then the MUSL remapped v̂^s [m s⁻¹]
+	std::vector<Vec3>      waterVelocityNew; // v^w_I at t^{n+1}, then the MUSL remapped v̂^w [m s⁻¹]
+
+	void resize(std::size_t n);
+};
+
+} // namespace mpm

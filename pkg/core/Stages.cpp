@@ -1,0 +1,417 @@
+#include "Stages.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace mpm {
+
+namespace {
+
+	// Shape-function weights of one point along the three axes (theory.md eq. 3.2).
+	template <class Kernel> inline void weightsAt(const GridGeometry& g, const Vec3& x, const Vec3& halfLength, Weights1D (&w)[3])
+	{
+		const Real invH = 1 / g.cellSize;
+		for (int d = 0; d < 3; ++d) Kernel::evaluate((x[d] - g.origin[d]) * invH, std::min<Real>(halfLength[d] * invH, 0.5), invH, w[d]);
+	}
+
+	// Call f(node, S, ∇S) for every node of the point's stencil (tensor product).
+	template <class Kernel, class F> inline void forEachNode(const GridGeometry& g, const Weights1D (&w)[3], F&& f)
+	{
+		constexpr int S = Kernel::stencil;
+		for (int c = 0; c < S; ++c)
+			for (int b = 0; b < S; ++b) {
+				const Real        vyz  = w[1].value[b] * w[2].value[c];
+				const Real        gyz  = w[1].gradient[b] * w[2].value[c];
+				const Real        vygz = w[1].value[b] * w[2].gradient[c];
+				const std::size_t row  = g.index(w[0].first, w[1].first + b, w[2].first + c);
+				for (int a = 0; a < S; ++a) {
+					const Real N = w[0].value[a] * vyz;
+					if (N == 0 && w[0].gradient[a] == 0) continue;
+					f(row + a, N, Vec3(w[0].gradient[a] * vyz, w[0].value[a] * gyz, w[0].value[a] * vygz));
+				}
+			}
+	}
+
+	// Race-free scatter: thread 0 adds into `target`, the others into private copies that are
+	// then summed node by node. Results differ between thread counts only by round-off.
+	inline SolidNode zeroOf(const SolidNode&) { return SolidNode { 0, Vec3::Zero(), Vec3::Zero(), 0, 0, 0 }; }
+	inline WaterNode zeroOf(const WaterNode&) { return WaterNode { 0, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero() }; }
+	inline Vec3      zeroOf(const Vec3&) { return Vec3::Zero(); }
+
+	template <class Node, class F> void scatter(std::vector<Node>& target, std::vector<std::vector<Node>>& buffers, std::size_t count, F&& perPoint)
+	{
+		const int threads = count < 4096 ? 1 : omp_get_max_threads();
+		if (threads == 1) {
+			for (std::size_t p = 0; p < count; ++p) perPoint(p, target.data());
+			return;
+		}
+		buffers.resize(threads - 1);
+		for (auto& b : buffers) b.assign(target.size(), zeroOf(Node {}));
+#pragma omp parallel num_threads(threads)
+		{
+			const int tid = omp_get_thread_num();
+			Node*     dst = tid == 0 ? target.data() : buffers[tid - 1].data();
+#pragma omp for schedule(static)
+			for (std::size_t p = 0; p < count; ++p) perPoint(p, dst);
+		}
+		const std::size_t nodes = target.size();
+#pragma omp parallel for schedule(static)
+		for (std::size_t i = 0; i < nodes; ++i)
+			for (auto& b : buffers) target[i] += b[i];
+	}
+
+	// Kozeny–Carman permeability ratio κ(n)/κ0 (theory.md eq. 1.7).
+	inline Real kozenyCarmanRatio(Real n, Real n0) { return (n * n * n / ((1 - n) * (1 - n))) / (n0 * n0 * n0 / ((1 - n0) * (1 - n0))); }
+
+	inline void applyConstraint(const std::array<bool, 3>& fixed, Vec3& v)
+	{
+		for (int d = 0; d < 3; ++d)
+			if (fixed[d]) v[d] = 0;
+	}
+
+} // namespace
+
+ConstrainedNodes ConstrainedNodes::build(const GridGeometry& grid, const BoundaryConditions& bcs)
+{
+	ConstrainedNodes out;
+	for (int k = 0; k < grid.nodes[2]; ++k)
+		for (int j = 0; j < grid.nodes[1]; ++j)
+			for (int i = 0; i < grid.nodes[0]; ++i) {
+				const NodeConstraint c = constraintAt(grid, bcs, i, j, k);
+				if (!c.any()) continue;
+				out.node.push_back(grid.index(i, j, k));
+				out.constraint.push_back(c);
+			}
+	return out;
+}
+
+namespace stages {
+
+	void resetGrid(GridFields& fields)
+	{
+		std::fill(fields.solid.begin(), fields.solid.end(), zeroOf(SolidNode {}));
+		std::fill(fields.water.begin(), fields.water.end(), zeroOf(WaterNode {}));
+	}
+
+	template <class Kernel>
+	void mapSolidToGrid(const GridGeometry& grid, const std::vector<SolidSet>& sets, const WaterParameters& water, const Vec3& gravity,
+	                    GridFields& fields, ScatterWorkspace& workspace)
+	{
+		for (const SolidSet& set : sets) {
+			const SolidPointSet& P         = *set.points;
+			const Real           invGrain  = 1 / set.soil.density;
+			const Real           dragScale = water.viscosity / set.soil.intrinsicPermeability; // μw/κ0
+			const Real           n0        = set.soil.porosity;
+			const bool           kc        = set.kozenyCarman;
+			scatter(fields.solid, workspace.solid, P.size(), [&](std::size_t p, SolidNode* nodes) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				const Real   m = P.mass[p], V = P.volume[p], n = P.porosity[p];
+				const Mat3   sigma   = voigtToMatrix(P.effectiveStress[p]);
+				const Vec3   weight  = m * gravity + P.externalForce[p];
+				const Vec3   mv      = m * P.velocity[p];
+				const Real   Q       = V * n * n * dragScale / (kc ? kozenyCarmanRatio(n, n0) : 1.0);
+				const Real   Vgrain  = m * invGrain;
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					SolidNode& node = nodes[I];
+					node.mass += N * m;
+					node.momentum += N * mv;
+					node.mixtureForce += N * weight - V * (sigma * dN); // eq. 4.2: f = Σ S m b − Σ V σ′·∇S
+					node.volume += N * V;
+					node.solidVolume += N * Vgrain;
+					node.drag += N * Q;
+				});
+			});
+		}
+	}
+
+	void computeNodalPorosity(GridFields& fields)
+	{
+		const std::size_t nodes = fields.solid.size();
+#pragma omp parallel for schedule(static)
+		for (std::size_t i = 0; i < nodes; ++i) {
+			const SolidNode& s  = fields.solid[i];
+			fields.porosity[i] = s.volume > 0 ? std::clamp<Real>(1 - s.solidVolume / s.volume, 0, 1) : 1;
+		}
+	}
+
+	template <class Kernel>
+	void mapWaterToGrid(const GridGeometry& grid, std::vector<WaterPointSet*>& sets, const Vec3& gravity, GridFields& fields, ScatterWorkspace& workspace)
+	{
+		const std::vector<Real>& nodalPorosity = fields.porosity;
+		for (WaterPointSet* set : sets) {
+			WaterPointSet& P = *set;
+			scatter(fields.water, workspace.water, P.size(), [&](std::size_t p, WaterNode* nodes) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				// eq. 4.5: porosity and its gradient at the water point from the nodal field
+				Real n = 0;
+				Vec3 gradN = Vec3::Zero();
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					n += N * nodalPorosity[I];
+					gradN += nodalPorosity[I] * dN;
+				});
+				n              = std::clamp<Real>(n, 1e-5, 1);
+				P.porosity[p]  = n;
+				const Real m = P.mass[p], V = P.volume[p], pressure = P.porePressure[p];
+				const Vec3 weight = m * gravity;
+				const Vec3 mv     = m * P.velocity[p];
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					WaterNode& node = nodes[I];
+					node.mass += N * m;
+					node.momentum += N * mv;
+					node.weight += N * weight;
+					node.porousForce += (V * pressure) * (n * dN + N * gradN); // eq. 4.6
+					node.pressureForce += (V * pressure) * dN;                 // eq. 4.7
+				});
+			});
+		}
+	}
+
+	void computeNodalVelocities(GridFields& fields, Real solidMassTolerance, Real waterMassTolerance)
+	{
+		const std::size_t nodes = fields.solid.size();
+#pragma omp parallel for schedule(static)
+		for (std::size_t i = 0; i < nodes; ++i) {
+			const SolidNode& s = fields.solid[i];
+			const WaterNode& w = fields.water[i];
+			fields.solidVelocity[i] = s.mass > solidMassTolerance ? Vec3(s.momentum / s.mass) : Vec3::Zero();
+			fields.waterVelocity[i] = w.mass > waterMassTolerance ? Vec3(w.momentum / w.mass) : Vec3::Zero();
+		}
+	}
+
+	void integrateNodalMomentum(GridFields& fields, const ConstrainedNodes& constrained, Real dt, DragScheme drag, Real solidMassTolerance,
+	                            Real waterMassTolerance)
+	{
+		const std::size_t nodes = fields.solid.size();
+#pragma omp parallel for schedule(static)
+		for (std::size_t i = 0; i < nodes; ++i) {
+			const SolidNode& s    = fields.solid[i];
+			const WaterNode& w    = fields.water[i];
+			const bool       hasS = s.mass > solidMassTolerance, hasW = w.mass > waterMassTolerance;
+			const Vec3       fm   = s.mixtureForce + w.pressureForce + w.weight; // mixture force f^m (eq. 4.8)
+			const Vec3       fw   = w.porousForce + w.weight;                     // water force f^w (eq. 4.8)
+			const Vec3&      vs   = fields.solidVelocity[i];
+			const Vec3&      vw   = fields.waterVelocity[i];
+			Vec3             vsNew = Vec3::Zero(), vwNew = Vec3::Zero();
+			if (hasS && hasW) {
+				const Real ms = s.mass, mw = w.mass, Q = s.drag, A = mw / dt;
+				if (drag == DragScheme::SemiImplicit) { // eq. 4.10, drag at t^{n+1}
+					vwNew = (A * vw + fw + Q * (vs + (mw / ms) * vw + (dt / ms) * fm)) / (A + Q * (1 + mw / ms));
+				} else { // eq. 4.9, drag at t^n
+					vwNew = vw + (dt / mw) * (fw - Q * (vw - vs));
+				}
+				vsNew = vs + (dt / ms) * fm + (mw / ms) * (vw - vwNew); // mixture momentum
+			} else if (hasW) { // free water: no solid, no drag
+				vwNew = vw + (dt / w.mass) * fw;
+			} else if (hasS) { // solid without water
+				vsNew = vs + (dt / s.mass) * fm;
+			}
+			fields.solidVelocityNew[i] = vsNew;
+			fields.waterVelocityNew[i] = vwNew;
+		}
+		// Walls (theory.md §2.3): a held component is zero; the other phase's free component is
+		// then re-solved with it known (water: drag to the held solid; solid: mixture momentum).
+		const std::size_t count = constrained.node.size();
+#pragma omp parallel for schedule(static)
+		for (std::size_t c = 0; c < count; ++c) {
+			const std::size_t     i  = constrained.node[c];
+			const NodeConstraint& nc = constrained.constraint[c];
+			const SolidNode&      s  = fields.solid[i];
+			const WaterNode&      w  = fields.water[i];
+			const bool hasS = s.mass > solidMassTolerance, hasW = w.mass > waterMassTolerance;
+			Vec3&      vsNew = fields.solidVelocityNew[i];
+			Vec3&      vwNew = fields.waterVelocityNew[i];
+			const Vec3 fm = s.mixtureForce + w.pressureForce + w.weight, fw = w.porousForce + w.weight;
+			for (int d = 0; d < 3; ++d) {
+				if (nc.solid[d]) vsNew[d] = 0;
+				if (nc.water[d]) vwNew[d] = 0;
+				if (!(hasS && hasW) || nc.solid[d] == nc.water[d]) continue;
+				const Real ms = s.mass, mw = w.mass, Q = s.drag, A = mw / dt;
+				const Real vs = fields.solidVelocity[i][d], vw = fields.waterVelocity[i][d];
+				if (nc.solid[d]) vwNew[d] = drag == DragScheme::SemiImplicit ? (A * vw + fw[d]) / (A + Q) : vw + (dt / mw) * (fw[d] - Q * (vw - vs));
+				else vsNew[d] = vs + (dt * fm[d] - mw * (vwNew[d] - vw)) / ms;
+			}
+		}
+	}
+
+	template <class Kernel>
+	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
+	                           MaterialPointSet& points, Real dt, Real flipBlend)
+	{
+		const std::size_t count   = points.size();
+		long              invalid = -1;
+#pragma omp parallel for schedule(static) reduction(max : invalid)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, points.position[p], points.halfLength[p], w);
+			Vec3 vNew = Vec3::Zero(), dv = Vec3::Zero();
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+				vNew += N * gridVelocityNew[I];
+				dv += N * (gridVelocityNew[I] - gridVelocity[I]);
+			});
+			const Vec3 v        = flipBlend * (points.velocity[p] + dv) + (1 - flipBlend) * vNew; // eq. 4.11
+			points.velocity[p]  = v;
+			points.position[p] += dt * vNew;
+			if (!v.allFinite()) invalid = std::max<long>(invalid, static_cast<long>(count - p)); // smallest index wins
+		}
+		return invalid < 0 ? -1 : static_cast<long>(count) - invalid;
+	}
+
+	template <class Kernel, class Node>
+	void remapVelocities(const GridGeometry& grid, const std::vector<const MaterialPointSet*>& sets, const std::vector<Node>& nodes,
+	                     Real massTolerance, const ConstrainedNodes& constrained, bool solidPhase, std::vector<Vec3>& remapped,
+	                     std::vector<std::vector<Vec3>>& workspace)
+	{
+		std::fill(remapped.begin(), remapped.end(), Vec3::Zero());
+		// momenta only: accumulate Σ S m v into `remapped`, then divide by the (unchanged) nodal mass
+		for (const MaterialPointSet* set : sets) {
+			const MaterialPointSet& P = *set;
+			scatter(remapped, workspace, P.size(), [&](std::size_t p, Vec3* momenta) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				const Vec3 mv = P.mass[p] * P.velocity[p];
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) { momenta[I] += N * mv; });
+			});
+		}
+		const std::size_t count = nodes.size();
+#pragma omp parallel for schedule(static)
+		for (std::size_t i = 0; i < count; ++i) remapped[i] = nodes[i].mass > massTolerance ? Vec3(remapped[i] / nodes[i].mass) : Vec3::Zero();
+		for (std::size_t c = 0; c < constrained.node.size(); ++c)
+			applyConstraint(solidPhase ? constrained.constraint[c].solid : constrained.constraint[c].water, remapped[constrained.node[c]]);
+	}
+
+	template <class Kernel>
+	void computeVelocityGradients(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const MaterialPointSet& P, std::vector<Mat3>& gradients)
+	{
+		const std::size_t count = P.size();
+		gradients.resize(count);
+#pragma omp parallel for schedule(static)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			Mat3 L = Mat3::Zero();
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) { L.noalias() += gridVelocity[I] * dN.transpose(); });
+			gradients[p] = L;
+		}
+	}
+
+	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& P, std::vector<Real>& values, std::vector<Real>& cellSum,
+	                      std::vector<Real>& cellVolume)
+	{
+		const std::size_t count = P.size();
+		cellSum.assign(grid.nodeCount(), 0);
+		cellVolume.assign(grid.nodeCount(), 0);
+		std::vector<std::size_t> cellOf(count);
+		const Real               invH = 1 / grid.cellSize;
+		for (std::size_t p = 0; p < count; ++p) { // serial: one add per point, deterministic
+			const Vec3        u = (P.position[p] - grid.origin) * invH;
+			const std::size_t c = grid.index(static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])), static_cast<int>(std::floor(u[2])));
+			cellOf[p]           = c;
+			cellSum[c] += P.volume[p] * values[p];
+			cellVolume[c] += P.volume[p];
+		}
+#pragma omp parallel for schedule(static)
+		for (std::size_t p = 0; p < count; ++p) values[p] = cellSum[cellOf[p]] / cellVolume[cellOf[p]];
+	}
+
+	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, SolidSet& set, Real dt)
+	{
+		SolidPointSet&    P      = *set.points;
+		const Real        E      = set.soil.youngModulus, nu = set.soil.poissonRatio;
+		const Real        lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), shear = E / (2 * (1 + nu));
+		const std::size_t count  = P.size();
+#pragma omp parallel for schedule(static)
+		for (std::size_t p = 0; p < count; ++p) {
+			const Mat3& L    = velocityGradients[p];
+			Mat3        d    = 0.5 * (L + L.transpose());
+			const Mat3  spin = 0.5 * (L - L.transpose());
+			if (volumetricRate) d.diagonal().array() += ((*volumetricRate)[p] - d.trace()) / 3; // B-bar (eq. 4.17)
+			// F and J follow the same (averaged) volumetric rate, so V and n stay consistent with σ′
+			const Mat3 dF = Mat3::Identity() + dt * (d + spin);
+			const Real dJ = dF.determinant();
+			Mat3&      F  = P.deformationGradient[p];
+			F             = dF * F;
+			P.volume[p]   = F.determinant() * P.initialVolume[p]; // eq. 4.14
+			const Mat3 sigma = voigtToMatrix(P.effectiveStress[p]);
+			const Mat3 rate  = lambda * d.trace() * Mat3::Identity() + 2 * shear * d; // D^e : d
+			P.effectiveStress[p] = matrixToVoigt(sigma + dt * (spin * sigma - sigma * spin + rate)); // eq. 4.15 (Jaumann)
+			P.porosity[p]        = std::clamp<Real>(1 - (1 - P.porosity[p]) / dJ, 1e-5, 1 - 1e-5); // eq. 1.1
+		}
+	}
+
+	template <class Kernel>
+	void computePressureRates(const GridGeometry& grid, const std::vector<Vec3>& solidVelocity, const std::vector<Vec3>& waterVelocity,
+	                          const WaterPointSet& P, const WaterParameters& water, std::vector<Real>& pressureRate, std::vector<Real>& waterDivergence)
+	{
+		const Real        Kw    = water.bulkModulus;
+		const std::size_t count = P.size();
+		pressureRate.resize(count);
+		waterDivergence.resize(count);
+#pragma omp parallel for schedule(static)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			Real divS = 0, divW = 0;
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) {
+				divS += solidVelocity[I].dot(dN);
+				divW += waterVelocity[I].dot(dN);
+			});
+			const Real n       = P.porosity[p];
+			pressureRate[p]    = -(Kw / n) * ((1 - n) * divS + n * divW); // eq. 4.16
+			waterDivergence[p] = divW;
+		}
+	}
+
+	void updatePorePressure(const std::vector<Real>& pressureRate, const std::vector<Real>& waterDivergence, WaterPointSet& P, Real dt)
+	{
+		const std::size_t count = P.size();
+#pragma omp parallel for schedule(static)
+		for (std::size_t p = 0; p < count; ++p) {
+			P.porePressure[p] += dt * pressureRate[p];
+			P.volume[p] *= 1 + dt * waterDivergence[p];
+		}
+	}
+
+	void updateDomainsCpGimp(SolidPointSet& P, Real cellSize)
+	{
+		const std::size_t count = P.size();
+#pragma omp parallel for schedule(static)
+		for (std::size_t p = 0; p < count; ++p)
+			for (int d = 0; d < 3; ++d)
+				P.halfLength[p][d] = std::clamp<Real>(P.initialHalfLength[p][d] * std::abs(P.deformationGradient[p](d, d)), 0.01 * cellSize, 0.5 * cellSize);
+	}
+
+	template <class Kernel> long firstPointOutsideGrid(const GridGeometry& grid, const MaterialPointSet& P)
+	{
+		for (std::size_t p = 0; p < P.size(); ++p) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			for (int d = 0; d < 3; ++d)
+				if (w[d].first < 0 || w[d].first + Kernel::stencil > grid.nodes[d]) return static_cast<long>(p);
+		}
+		return -1;
+	}
+
+#define MPM_INSTANTIATE_STAGES(K)                                                                                                          \
+	template void mapSolidToGrid<K>(const GridGeometry&, const std::vector<SolidSet>&, const WaterParameters&, const Vec3&, GridFields&,   \
+	                                ScatterWorkspace&);                                                                                    \
+	template void mapWaterToGrid<K>(const GridGeometry&, std::vector<WaterPointSet*>&, const Vec3&, GridFields&, ScatterWorkspace&);       \
+	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, MaterialPointSet&,    \
+	                                       Real, Real);                                                                                    \
+	template void remapVelocities<K, SolidNode>(const GridGeometry&, const std::vector<const MaterialPointSet*>&,                          \
+	                                            const std::vector<SolidNode>&, Real, const ConstrainedNodes&, bool, std::vector<Vec3>&, std::vector<std::vector<Vec3>>&); \
+	template void remapVelocities<K, WaterNode>(const GridGeometry&, const std::vector<const MaterialPointSet*>&,                          \
+	                                            const std::vector<WaterNode>&, Real, const ConstrainedNodes&, bool, std::vector<Vec3>&, std::vector<std::vector<Vec3>>&); \
+	template void computeVelocityGradients<K>(const GridGeometry&, const std::vector<Vec3>&, const MaterialPointSet&, std::vector<Mat3>&);  \
+	template void computePressureRates<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const WaterPointSet&,   \
+	                                     const WaterParameters&, std::vector<Real>&, std::vector<Real>&);                                   \
+	template long firstPointOutsideGrid<K>(const GridGeometry&, const MaterialPointSet&);
+
+	MPM_INSTANTIATE_STAGES(LinearKernel)
+	MPM_INSTANTIATE_STAGES(GimpKernel)
+
+} // namespace stages
+} // namespace mpm

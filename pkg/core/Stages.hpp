@@ -1,0 +1,116 @@
+// The stages of one explicit step (doc/theory.md §4), each a free function with no hidden state:
+// it reads and writes what its arguments name. OpenMP lives inside the stages. The solver
+// (TwoPhaseSolver.cpp) calls them in order; the list there reads as the algorithm.
+#pragma once
+
+#include "BoundaryConditions.hpp"
+#include "Grid.hpp"
+#include "Parameters.hpp"
+#include "PointSets.hpp"
+#include "ShapeFunctions.hpp"
+
+#include <vector>
+
+namespace mpm {
+
+enum class DragScheme {
+	SemiImplicit, // drag implicit per node (theory.md eq. 4.6): no drag time-step limit
+	Explicit,     // drag explicit (theory.md eq. 4.4): Δt < 2/λ, see criticalTimeStep
+};
+
+// A set of solid points and the parameters of its material.
+struct SolidSet {
+	SolidPointSet* points;
+	SoilParameters soil;
+	bool           kozenyCarman = false; // κ(n) by the Kozeny–Carman ratio (theory.md eq. 1.7)
+};
+
+// Thread-private copies of the nodal arrays for race-free scatter (one per extra thread).
+struct ScatterWorkspace {
+	std::vector<std::vector<SolidNode>> solid;
+	std::vector<std::vector<WaterNode>> water;
+	std::vector<std::vector<Vec3>>      momentum;
+};
+
+// Grid nodes whose velocity has at least one constrained component, and the constraint.
+struct ConstrainedNodes {
+	std::vector<std::size_t>    node;
+	std::vector<NodeConstraint> constraint;
+	static ConstrainedNodes     build(const GridGeometry& grid, const BoundaryConditions& bcs);
+};
+
+namespace stages {
+
+	// Step 0: zero every nodal array.
+	void resetGrid(GridFields& fields);
+
+	// Step 2 (theory.md eqs. 4.1–4.3): solid mass, momentum, effective-stress force, weight,
+	// point loads, mixture and grain volumes, drag coefficient.
+	template <class Kernel>
+	void mapSolidToGrid(const GridGeometry& grid, const std::vector<SolidSet>& sets, const WaterParameters& water, const Vec3& gravity,
+	                    GridFields& fields, ScatterWorkspace& workspace);
+
+	// Nodal porosity n_I = 1 − Σ S m/ρs / Σ S V (theory.md eq. 4.4); 1 where there is no solid.
+	void computeNodalPorosity(GridFields& fields);
+
+	// Steps 3–4 (theory.md eqs. 4.5–4.7): porosity at water points from the nodal field, then water
+	// mass, momentum, weight, −n∇p force (incl. the porosity-gradient term) and the pressure force.
+	template <class Kernel>
+	void mapWaterToGrid(const GridGeometry& grid, std::vector<WaterPointSet*>& sets, const Vec3& gravity, GridFields& fields,
+	                    ScatterWorkspace& workspace);
+
+	// Step 5: v_I = P_I / m_I for nodes above the mass tolerance, else 0.
+	void computeNodalVelocities(GridFields& fields, Real solidMassTolerance, Real waterMassTolerance);
+
+	// Step 6 (theory.md eqs. 4.8–4.10): coupled nodal momentum of water and mixture with
+	// semi-implicit or explicit drag, then the velocity constraints of the walls.
+	void integrateNodalMomentum(GridFields& fields, const ConstrainedNodes& constrained, Real dt, DragScheme drag,
+	                            Real solidMassTolerance, Real waterMassTolerance);
+
+	// Step 7 (theory.md eq. 4.11): G2P with FLIP/PIC blend α; positions move with the new grid
+	// velocity. Returns the index of the first point with a non-finite velocity, or -1.
+	template <class Kernel>
+	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
+	                           MaterialPointSet& points, Real dt, Real flipBlend);
+
+	// Step 8 (theory.md eq. 4.12): MUSL re-map of the point momenta of one phase to the grid,
+	// written to `remapped` (v̂_I), then the wall constraints of that phase.
+	template <class Kernel, class Node>
+	void remapVelocities(const GridGeometry& grid, const std::vector<const MaterialPointSet*>& sets, const std::vector<Node>& nodes,
+	                     Real massTolerance, const ConstrainedNodes& constrained, bool solidPhase, std::vector<Vec3>& remapped,
+	                     std::vector<std::vector<Vec3>>& workspace);
+
+	// Velocity gradient L_ij = Σ v_i ∂S/∂x_j at every point of a set (theory.md eq. 4.13).
+	template <class Kernel>
+	void computeVelocityGradients(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const MaterialPointSet& points,
+	                              std::vector<Mat3>& gradients);
+
+	// Replace each point's value by the volume-weighted mean over the points of its grid cell
+	// (theory.md eq. 4.17): removes the intra-cell pressure mode of nearly incompressible water.
+	// `cellSum`/`cellVolume` are scratch arrays of grid.nodeCount() entries.
+	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& points, std::vector<Real>& values, std::vector<Real>& cellSum,
+	                      std::vector<Real>& cellVolume);
+
+	// Step 9 (theory.md eqs. 4.14–4.15): deformation gradient, volume, Jaumann elastic effective-
+	// stress update and porosity from the velocity gradients; `volumetricRate` (one per point)
+	// replaces tr d when given (cell-averaged volumetric strain rate, B-bar).
+	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, SolidSet& set, Real dt);
+
+	// Step 10 (theory.md eq. 4.16): pore-pressure rate ṗ = −(Kw/n)[(1−n)∇·v^s + n∇·v^w] at every
+	// water point, from the divergences of both grid velocities (nodes without solid have v̂^s = 0).
+	template <class Kernel>
+	void computePressureRates(const GridGeometry& grid, const std::vector<Vec3>& solidVelocity, const std::vector<Vec3>& waterVelocity,
+	                          const WaterPointSet& points, const WaterParameters& water, std::vector<Real>& pressureRate,
+	                          std::vector<Real>& waterDivergence);
+
+	// Advance pore pressure and water volume with the (possibly cell-averaged) rates.
+	void updatePorePressure(const std::vector<Real>& pressureRate, const std::vector<Real>& waterDivergence, WaterPointSet& points, Real dt);
+
+	// Step 11 (theory.md eq. 3.3): cpGIMP domains follow the stretch, l_i = l0_i F_ii in [0.01 h, h/2].
+	void updateDomainsCpGimp(SolidPointSet& points, Real cellSize);
+
+	// Index of the first point whose stencil leaves the grid, or -1.
+	template <class Kernel> long firstPointOutsideGrid(const GridGeometry& grid, const MaterialPointSet& points);
+
+} // namespace stages
+} // namespace mpm

@@ -1,0 +1,242 @@
+#include "TwoPhaseSolver.hpp"
+
+#include "Errors.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace mpm {
+
+namespace {
+	constexpr double inf = std::numeric_limits<double>::infinity();
+
+	// Times one stage into its slot of `seconds`.
+	class StageTimer {
+	public:
+		StageTimer(std::array<double, static_cast<int>(Stage::Count)>& seconds, Stage stage)
+		        : seconds_(seconds)
+		        , stage_(stage)
+		        , start_(std::chrono::steady_clock::now())
+		{
+		}
+		~StageTimer() { seconds_[static_cast<int>(stage_)] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+
+	private:
+		std::array<double, static_cast<int>(Stage::Count)>& seconds_;
+		Stage                                                stage_;
+		std::chrono::steady_clock::time_point                start_;
+	};
+
+	Real smallestMass(const MaterialPointSet& set, Real current)
+	{
+		for (Real m : set.mass) current = std::min(current, m);
+		return current;
+	}
+} // namespace
+
+const char* stageName(Stage s)
+{
+	switch (s) {
+		case Stage::ResetGrid: return "resetGrid";
+		case Stage::MapSolidToGrid: return "mapSolidToGrid";
+		case Stage::MapWaterToGrid: return "mapWaterToGrid";
+		case Stage::IntegrateNodalMomentum: return "integrateNodalMomentum";
+		case Stage::UpdatePointKinematics: return "updatePointKinematics";
+		case Stage::RemapVelocities: return "remapVelocities";
+		case Stage::UpdateSolidStress: return "updateSolidStress";
+		case Stage::UpdatePorePressure: return "updatePorePressure";
+		case Stage::UpdateDomains: return "updateDomains";
+		case Stage::Count: break;
+	}
+	return "?";
+}
+
+void SolverSettings::validate() const
+{
+	requireClosedRange("flipBlend", flipBlend, 0, 1, "");
+	requireOpenRange("timeStepFactor", timeStepFactor, 0, 1 + 1e-15, "");
+	if (!gravity.allFinite()) throw InvalidParameter("gravity must have finite components [m s⁻²]");
+}
+
+TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& settings)
+        : domain_(domain)
+        , settings_(settings)
+        , grid_(GridGeometry::forDomain(domain.lower, domain.upper, domain.cellSize))
+{
+	settings_.validate();
+	fields_.resize(grid_.nodeCount());
+	constrained_ = ConstrainedNodes::build(grid_, domain.boundaries);
+}
+
+void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPointSet*> waters, const WaterParameters& water)
+{
+	water.validate();
+	Real minSolid = inf, minWater = inf;
+	for (std::size_t s = 0; s < solids.size(); ++s) {
+		solids[s].soil.validate();
+		solids[s].points->validate("solid set " + std::to_string(s));
+		minSolid = smallestMass(*solids[s].points, minSolid);
+	}
+	for (std::size_t w = 0; w < waters.size(); ++w) {
+		waters[w]->validate("water set " + std::to_string(w));
+		minWater = smallestMass(*waters[w], minWater);
+	}
+	solids_ = std::move(solids);
+	waters_ = std::move(waters);
+	water_  = water;
+	// a node is "empty" below a billionth of the lightest point's mass (theory.md §2.2 step 5)
+	solidMassTolerance_ = std::isfinite(minSolid) ? 1e-9 * minSolid : 0;
+	waterMassTolerance_ = std::isfinite(minWater) ? 1e-9 * minWater : 0;
+	throwIfOutsideGrid();
+}
+
+TimeStepLimits TwoPhaseSolver::timeStepLimits() const
+{
+	const bool hasWater = !waters_.empty();
+	const Real rhoW = water_.density, Kw = water_.bulkModulus;
+	Real       speed = hasWater ? std::sqrt(Kw / rhoW) : 0, dragLimit = inf; // water alone (free water)
+	Real       pointSpeed = 0;
+	for (const SolidSet& set : solids_) {
+		const SoilParameters& s   = set.soil;
+		const Real            n   = s.porosity;
+		const Real            Ec  = s.constrainedModulus();
+		const Real            rhoS = (1 - n) * s.density;                       // partial density of the skeleton
+		speed                     = std::max(speed, std::sqrt(Ec / rhoS));      // skeleton alone
+		if (hasWater) {
+			const Real rhoSat = rhoS + n * rhoW;
+			speed             = std::max(speed, std::sqrt((Ec + Kw / n) / rhoSat)); // undrained P wave
+			if (settings_.drag == DragScheme::Explicit) {
+				Real nMax = n;
+				for (Real np : set.points->porosity) nMax = std::max(nMax, np);
+				const Real kappa  = set.kozenyCarman ? s.intrinsicPermeability * (nMax * nMax * nMax / ((1 - nMax) * (1 - nMax))) / (n * n * n / ((1 - n) * (1 - n))) : s.intrinsicPermeability;
+				const Real Q      = nMax * nMax * water_.viscosity / std::min(kappa, s.intrinsicPermeability);
+				const Real lambda = Q * (1 / (nMax * rhoW) + 1 / ((1 - nMax) * s.density));
+				dragLimit         = std::min(dragLimit, 2 / lambda); // theory.md eq. 4.5
+			}
+		}
+		for (const Vec3& v : set.points->velocity) pointSpeed = std::max(pointSpeed, v.norm());
+	}
+	for (const WaterPointSet* set : waters_)
+		for (const Vec3& v : set->velocity) pointSpeed = std::max(pointSpeed, v.norm());
+	TimeStepLimits limits;
+	limits.wave     = speed + pointSpeed > 0 ? grid_.cellSize / (speed + pointSpeed) : inf;
+	limits.drag     = dragLimit;
+	limits.critical = std::min(limits.wave, limits.drag);
+	return limits;
+}
+
+long TwoPhaseSolver::advance(Real dt)
+{
+	requireOpenRange("dt", dt, 0, inf, "s");
+	const Real allowed = settings_.timeStepFactor * timeStepLimits().critical;
+	const long substeps = std::isfinite(allowed) ? std::max<long>(1, static_cast<long>(std::ceil(dt / allowed * (1 - 1e-12)))) : 1;
+	for (long i = 0; i < substeps; ++i) step(dt / substeps);
+	return substeps;
+}
+
+void TwoPhaseSolver::step(Real dt)
+{
+	switch (settings_.shapeFunction) {
+		case ShapeFunction::Linear: stepWith<LinearKernel>(dt); break;
+		case ShapeFunction::UGimp:
+		case ShapeFunction::CpGimp: stepWith<GimpKernel>(dt); break;
+	}
+	++steps_;
+}
+
+// The explicit step, MUSL with FLIP/PIC blend (theory.md §4, Steps 0–11).
+template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
+{
+	using namespace stages;
+	const Vec3& g = settings_.gravity;
+	{
+		StageTimer t(stageSeconds_, Stage::ResetGrid);
+		resetGrid(fields_);
+	}
+	{
+		StageTimer t(stageSeconds_, Stage::MapSolidToGrid);
+		mapSolidToGrid<Kernel>(grid_, solids_, water_, g, fields_, workspace_);
+		computeNodalPorosity(fields_);
+	}
+	{
+		StageTimer t(stageSeconds_, Stage::MapWaterToGrid);
+		mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_);
+	}
+	{
+		StageTimer t(stageSeconds_, Stage::IntegrateNodalMomentum);
+		computeNodalVelocities(fields_, solidMassTolerance_, waterMassTolerance_);
+		integrateNodalMomentum(fields_, constrained_, dt, settings_.drag, solidMassTolerance_, waterMassTolerance_);
+	}
+	{
+		StageTimer t(stageSeconds_, Stage::UpdatePointKinematics);
+		auto check = [&](long bad, const char* phase, std::size_t set) {
+			if (bad < 0) return;
+			std::ostringstream msg;
+			msg << "unstable at step " << steps_ << ": " << phase << " set " << set << ", point " << bad
+			    << ": velocity is not finite (reduce the time step, timeStepFactor, or check the drag and boundary conditions)";
+			throw InstabilityError(msg.str());
+		};
+		for (std::size_t s = 0; s < solids_.size(); ++s)
+			check(updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, *solids_[s].points, dt, settings_.flipBlend), "solid", s);
+		for (std::size_t w = 0; w < waters_.size(); ++w)
+			check(updatePointKinematics<Kernel>(grid_, fields_.waterVelocity, fields_.waterVelocityNew, *waters_[w], dt, settings_.flipBlend), "water", w);
+	}
+	throwIfOutsideGrid();
+	{
+		StageTimer                           t(stageSeconds_, Stage::RemapVelocities);
+		std::vector<const MaterialPointSet*> solidSets, waterSets;
+		for (const SolidSet& s : solids_) solidSets.push_back(s.points);
+		for (const WaterPointSet* w : waters_) waterSets.push_back(w);
+		remapVelocities<Kernel>(grid_, solidSets, fields_.solid, solidMassTolerance_, constrained_, true, fields_.solidVelocityNew, workspace_.momentum);
+		remapVelocities<Kernel>(grid_, waterSets, fields_.water, waterMassTolerance_, constrained_, false, fields_.waterVelocityNew, workspace_.momentum);
+	}
+	const bool average = settings_.cellAveragedVolumetricRate;
+	{
+		StageTimer t(stageSeconds_, Stage::UpdateSolidStress);
+		for (SolidSet& s : solids_) {
+			computeVelocityGradients<Kernel>(grid_, fields_.solidVelocityNew, *s.points, velocityGradients_);
+			if (average) {
+				volumetricRate_.resize(velocityGradients_.size());
+				for (std::size_t p = 0; p < velocityGradients_.size(); ++p) volumetricRate_[p] = velocityGradients_[p].trace();
+				averageOverCells(grid_, *s.points, volumetricRate_, cellSum_, cellVolume_);
+			}
+			updateSolidStress(velocityGradients_, average ? &volumetricRate_ : nullptr, s, dt);
+		}
+	}
+	{
+		StageTimer t(stageSeconds_, Stage::UpdatePorePressure);
+		for (WaterPointSet* w : waters_) {
+			computePressureRates<Kernel>(grid_, fields_.solidVelocityNew, fields_.waterVelocityNew, *w, water_, pressureRate_, waterDivergence_);
+			if (average) {
+				averageOverCells(grid_, *w, pressureRate_, cellSum_, cellVolume_);
+				averageOverCells(grid_, *w, waterDivergence_, cellSum_, cellVolume_);
+			}
+			updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
+			applyDrainedFaces(grid_, domain_.boundaries, *w);
+		}
+	}
+	if (settings_.shapeFunction == ShapeFunction::CpGimp) {
+		StageTimer t(stageSeconds_, Stage::UpdateDomains);
+		for (SolidSet& s : solids_) updateDomainsCpGimp(*s.points, grid_.cellSize);
+	}
+}
+
+void TwoPhaseSolver::throwIfOutsideGrid() const
+{
+	auto check = [&](const MaterialPointSet& set, const char* phase, std::size_t index) {
+		const long p = settings_.shapeFunction == ShapeFunction::Linear ? stages::firstPointOutsideGrid<LinearKernel>(grid_, set)
+		                                                                 : stages::firstPointOutsideGrid<GimpKernel>(grid_, set);
+		if (p < 0) return;
+		std::ostringstream msg;
+		msg << "at step " << steps_ << ": " << phase << " set " << index << ", point " << p << " at (" << set.position[p].transpose()
+		    << ") m is outside the grid, which spans the domain (" << grid_.lower().transpose() << ")..(" << grid_.upper().transpose()
+		    << ") m plus one cell";
+		throw InstabilityError(msg.str());
+	};
+	for (std::size_t s = 0; s < solids_.size(); ++s) check(*solids_[s].points, "solid", s);
+	for (std::size_t w = 0; w < waters_.size(); ++w) check(*waters_[w], "water", w);
+}
+
+} // namespace mpm

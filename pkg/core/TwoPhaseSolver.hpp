@@ -1,0 +1,94 @@
+// Explicit two-phase (solid + pore water) GIMP MPM: the time step as a list of named stages
+// (doc/theory.md §4), time-step limits and sub-stepping. No YADE here: the binding hands over
+// pointers to the point sets it owns and the validated parameters.
+#pragma once
+
+#include "Stages.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace mpm {
+
+struct SolverSettings {
+	ShapeFunction shapeFunction  = ShapeFunction::UGimp;
+	DragScheme    drag           = DragScheme::SemiImplicit;
+	Real          flipBlend      = 1.0;  // α [-], 0 ≤ α ≤ 1 (1 = FLIP, 0 = PIC)
+	Real          timeStepFactor = 0.5;  // C [-], 0 < C ≤ 1, applied to the critical step
+	Vec3          gravity        = Vec3::Zero(); // b [m s⁻²]
+	bool          cellAveragedVolumetricRate = true; // theory.md eq. 4.17 (pressure and B-bar)
+	void          validate() const;
+};
+
+// The domain box (walls on its faces) and the grid cell size.
+struct Domain {
+	Vec3               lower    = Vec3::Zero(); // [m]
+	Vec3               upper    = Vec3::Ones(); // [m]
+	Real               cellSize = 0.1;          // h [m]
+	BoundaryConditions boundaries;
+};
+
+// Time-step limits of the current state (theory.md §4.1–4.2), before the safety factor.
+struct TimeStepLimits {
+	Real wave;     // h / fastest wave (+ fastest point) [s]
+	Real drag;     // 2/λ of the explicit drag; infinity with semi-implicit drag [s]
+	Real critical; // min of the above [s]
+};
+
+enum class Stage {
+	ResetGrid,
+	MapSolidToGrid,
+	MapWaterToGrid,
+	IntegrateNodalMomentum,
+	UpdatePointKinematics,
+	RemapVelocities,
+	UpdateSolidStress,
+	UpdatePorePressure,
+	UpdateDomains,
+	Count
+};
+const char* stageName(Stage s);
+
+class TwoPhaseSolver {
+public:
+	TwoPhaseSolver(const Domain& domain, const SolverSettings& settings);
+
+	// The sets advanced by step() (not owned). Validates the sets and the parameters.
+	void setPoints(std::vector<SolidSet> solids, std::vector<WaterPointSet*> waters, const WaterParameters& water);
+
+	TimeStepLimits timeStepLimits() const;
+	// One explicit step of size dt (no sub-stepping). Throws InstabilityError naming the step,
+	// the point and the quantity if the state stops being finite or a point leaves the grid.
+	void step(Real dt);
+	// Advance by dt in equal sub-steps no larger than timeStepFactor × critical; returns their number.
+	long advance(Real dt);
+
+	long                                                stepCount() const { return steps_; }
+	const std::array<double, static_cast<int>(Stage::Count)>& stageSeconds() const { return stageSeconds_; }
+	const GridGeometry&                                 grid() const { return grid_; }
+	const GridFields&                                   fields() const { return fields_; }
+	const SolverSettings&                               settings() const { return settings_; }
+
+private:
+	template <class Kernel> void stepWith(Real dt);
+	void                         throwIfOutsideGrid() const;
+
+	Domain                        domain_;
+	SolverSettings                settings_;
+	GridGeometry                  grid_;
+	GridFields                    fields_;
+	ConstrainedNodes              constrained_;
+	ScatterWorkspace              workspace_;
+	std::vector<Mat3>             velocityGradients_;
+	std::vector<Real>             volumetricRate_, pressureRate_, waterDivergence_, cellSum_, cellVolume_;
+	std::vector<SolidSet>         solids_;
+	std::vector<WaterPointSet*>   waters_;
+	WaterParameters               water_;
+	Real                          solidMassTolerance_ = 0;
+	Real                          waterMassTolerance_ = 0;
+	long                          steps_              = 0;
+	std::array<double, static_cast<int>(Stage::Count)> stageSeconds_ {};
+};
+
+} // namespace mpm
