@@ -31,7 +31,7 @@ void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, 
 		if (wall.water != WaterWall::Drained) continue;
 		const int  axis = face / 2;
 		const bool upperFace = face % 2 == 1;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			const Real x = points.position[p][axis], l = points.halfLength[p][axis];
 			const bool reaches = upperFace ? x + l >= upper[axis] - tolerance : x - l <= lower[axis] + tolerance;

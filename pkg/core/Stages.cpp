@@ -42,7 +42,7 @@ namespace {
 
 	template <class Node, class F> void scatter(std::vector<Node>& target, std::vector<std::vector<Node>>& buffers, std::size_t count, F&& perPoint)
 	{
-		const int threads = count < 4096 ? 1 : omp_get_max_threads();
+		const int threads = count <= parallelThreshold ? 1 : omp_get_max_threads();
 		if (threads == 1) {
 			for (std::size_t p = 0; p < count; ++p) perPoint(p, target.data());
 			return;
@@ -57,7 +57,7 @@ namespace {
 			for (std::size_t p = 0; p < count; ++p) perPoint(p, dst);
 		}
 		const std::size_t nodes = target.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 		for (std::size_t i = 0; i < nodes; ++i)
 			for (auto& b : buffers) target[i] += b[i];
 	}
@@ -130,7 +130,7 @@ namespace stages {
 	void computeNodalPorosity(GridFields& fields)
 	{
 		const std::size_t nodes = fields.solid.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 		for (std::size_t i = 0; i < nodes; ++i) {
 			const SolidNode& s  = fields.solid[i];
 			fields.porosity[i] = s.volume > 0 ? std::clamp<Real>(1 - s.solidVolume / s.volume, 0, 1) : 1;
@@ -173,7 +173,7 @@ namespace stages {
 	void computeNodalVelocities(GridFields& fields, Real solidMassTolerance, Real waterMassTolerance)
 	{
 		const std::size_t nodes = fields.solid.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 		for (std::size_t i = 0; i < nodes; ++i) {
 			const SolidNode& s = fields.solid[i];
 			const WaterNode& w = fields.water[i];
@@ -186,7 +186,7 @@ namespace stages {
 	                            Real waterMassTolerance)
 	{
 		const std::size_t nodes = fields.solid.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 		for (std::size_t i = 0; i < nodes; ++i) {
 			const SolidNode& s    = fields.solid[i];
 			const WaterNode& w    = fields.water[i];
@@ -215,7 +215,7 @@ namespace stages {
 		// Walls (theory.md §2.3): a held component is zero; the other phase's free component is
 		// then re-solved with it known (water: drag to the held solid; solid: mixture momentum).
 		const std::size_t count = constrained.node.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t c = 0; c < count; ++c) {
 			const std::size_t     i  = constrained.node[c];
 			const NodeConstraint& nc = constrained.constraint[c];
@@ -243,7 +243,7 @@ namespace stages {
 	{
 		const std::size_t count   = points.size();
 		long              invalid = -1;
-#pragma omp parallel for schedule(static) reduction(max : invalid)
+#pragma omp parallel for schedule(static) reduction(max : invalid) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, points.position[p], points.halfLength[p], w);
@@ -277,7 +277,7 @@ namespace stages {
 			});
 		}
 		const std::size_t count = nodes.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t i = 0; i < count; ++i) remapped[i] = nodes[i].mass > massTolerance ? Vec3(remapped[i] / nodes[i].mass) : Vec3::Zero();
 		for (std::size_t c = 0; c < constrained.node.size(); ++c)
 			applyConstraint(solidPhase ? constrained.constraint[c].solid : constrained.constraint[c].water, remapped[constrained.node[c]]);
@@ -288,7 +288,7 @@ namespace stages {
 	{
 		const std::size_t count = P.size();
 		gradients.resize(count);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
@@ -313,7 +313,7 @@ namespace stages {
 			cellSum[c] += P.volume[p] * values[p];
 			cellVolume[c] += P.volume[p];
 		}
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) values[p] = cellSum[cellOf[p]] / cellVolume[cellOf[p]];
 	}
 
@@ -323,7 +323,7 @@ namespace stages {
 		const Real        E      = set.soil.youngModulus, nu = set.soil.poissonRatio;
 		const Real        lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), shear = E / (2 * (1 + nu));
 		const std::size_t count  = P.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			const Mat3& L    = velocityGradients[p];
 			Mat3        d    = 0.5 * (L + L.transpose());
@@ -350,7 +350,7 @@ namespace stages {
 		const std::size_t count = P.size();
 		pressureRate.resize(count);
 		waterDivergence.resize(count);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
@@ -368,7 +368,7 @@ namespace stages {
 	void updatePorePressure(const std::vector<Real>& pressureRate, const std::vector<Real>& waterDivergence, WaterPointSet& P, Real dt)
 	{
 		const std::size_t count = P.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			P.porePressure[p] += dt * pressureRate[p];
 			P.volume[p] *= 1 + dt * waterDivergence[p];
@@ -378,7 +378,7 @@ namespace stages {
 	void updateDomainsCpGimp(SolidPointSet& P, Real cellSize)
 	{
 		const std::size_t count = P.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p)
 			for (int d = 0; d < 3; ++d)
 				P.halfLength[p][d] = std::clamp<Real>(P.initialHalfLength[p][d] * std::abs(P.deformationGradient[p](d, d)), 0.01 * cellSize, 0.5 * cellSize);
