@@ -255,7 +255,8 @@ namespace stages {
 			const Vec3 v        = flipBlend * (points.velocity[p] + dv) + (1 - flipBlend) * vNew; // eq. 4.11
 			points.velocity[p]  = v;
 			points.position[p] += dt * vNew;
-			if (!v.allFinite()) invalid = std::max<long>(invalid, static_cast<long>(count - p)); // smallest index wins
+			if (!v.allFinite() || !(dt * vNew.norm() <= grid.cellSize))
+				invalid = std::max<long>(invalid, static_cast<long>(count - p)); // smallest index wins
 		}
 		return invalid < 0 ? -1 : static_cast<long>(count) - invalid;
 	}

@@ -68,7 +68,9 @@ namespace stages {
 	                            Real solidMassTolerance, Real waterMassTolerance);
 
 	// Step 7 (theory.md eq. 4.11): G2P with FLIP/PIC blend α; positions move with the new grid
-	// velocity. Returns the index of the first point with a non-finite velocity, or -1.
+	// velocity. Returns the index of the first runaway point, or -1: one whose velocity is not
+	// finite or whose displacement in this step exceeds the cell size (a CFL violation that no
+	// stable explicit step produces).
 	template <class Kernel>
 	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
 	                           MaterialPointSet& points, Real dt, Real flipBlend);

@@ -171,17 +171,22 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	}
 	{
 		StageTimer t(stageSeconds_, Stage::UpdatePointKinematics);
-		auto check = [&](long bad, const char* phase, std::size_t set) {
+		auto check = [&](long bad, const char* phase, std::size_t set, const MaterialPointSet& points) {
 			if (bad < 0) return;
 			std::ostringstream msg;
-			msg << "unstable at step " << steps_ << ": " << phase << " set " << set << ", point " << bad
-			    << ": velocity is not finite (reduce the time step, timeStepFactor, or check the drag and boundary conditions)";
+			msg << "unstable at step " << steps_ << ": " << phase << " set " << set << ", point " << bad << " at (" << points.position[bad].transpose()
+			    << ") m: velocity |v| = " << points.velocity[bad].norm() << " m/s"
+			    << (points.velocity[bad].allFinite() ? " moves it more than one cell (" + std::to_string(grid_.cellSize) + " m) in one step of " + std::to_string(dt) + " s"
+			                                         : " is not finite")
+			    << " (reduce O.dt or timeStepFactor, or check the drag scheme and the boundary conditions)";
 			throw InstabilityError(msg.str());
 		};
 		for (std::size_t s = 0; s < solids_.size(); ++s)
-			check(updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, *solids_[s].points, dt, settings_.flipBlend), "solid", s);
+			check(updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, *solids_[s].points, dt, settings_.flipBlend), "solid", s,
+			      *solids_[s].points);
 		for (std::size_t w = 0; w < waters_.size(); ++w)
-			check(updatePointKinematics<Kernel>(grid_, fields_.waterVelocity, fields_.waterVelocityNew, *waters_[w], dt, settings_.flipBlend), "water", w);
+			check(updatePointKinematics<Kernel>(grid_, fields_.waterVelocity, fields_.waterVelocityNew, *waters_[w], dt, settings_.flipBlend), "water", w,
+			      *waters_[w]);
 	}
 	throwIfOutsideGrid();
 	{

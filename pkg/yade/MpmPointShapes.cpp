@@ -26,6 +26,7 @@ const AttrTable<MpmSolidPoints>& MpmSolidPoints::attributes()
 		pointArrayAttr("defGrad", &S::points, &SolidPointSet::deformationGradient, "Deformation gradient F of each point, shape (N, 3, 3) [-]"),
 		pointArrayAttr("stress", &S::points, &SolidPointSet::effectiveStress, "Effective stress σ′ (tension-positive), symmetric, shape (N, 3, 3) [Pa]"),
 		pointArrayAttr("porosity", &S::points, &SolidPointSet::porosity, "Porosity n of the mixture at each solid point, shape (N,) [-]"),
+		pointArrayAttr("extForce", &S::points, &SolidPointSet::externalForce, "Prescribed load on each point, e.g. a surface traction times the point's face area, shape (N, 3) [N]"),
 		readOnly(AttrSpec<S> { "count", "Number of points N [-]", [](const S& s) { return py::object(s.points.size()); }, nullptr }),
 	};
 	return table;
@@ -73,6 +74,7 @@ template <class Archive> void MpmSolidPoints::serialize(Archive& ar, unsigned in
 	serializeFlat(ar, "deformationGradient", points.deformationGradient);
 	serializeFlat(ar, "effectiveStress", points.effectiveStress);
 	serializeFlat(ar, "porosity", points.porosity);
+	serializeFlat(ar, "externalForce", points.externalForce);
 }
 
 template <class Archive> void MpmWaterPoints::serialize(Archive& ar, unsigned int)

@@ -4,34 +4,121 @@
 #include "MpmPointShapes.hpp"
 #include "Serialization.hpp"
 
+#include <boost/serialization/vector.hpp>
+
 #include "../core/Errors.hpp"
 
+#include <array>
 #include <limits>
 
 namespace yade_mpm {
 
+namespace {
+	constexpr const char* faceNames[6] = { "xMin", "xMax", "yMin", "yMax", "zMin", "zMax" };
+
+	// Map a user's option name to the core enum; unknown names are refused listing the valid ones.
+	template <class Enum, std::size_t N>
+	Enum parseOption(const std::string& attribute, const std::string& value, const std::array<std::pair<const char*, Enum>, N>& options)
+	{
+		std::string valid;
+		for (const auto& [name, e] : options) {
+			if (value == name) return e;
+			valid += (valid.empty() ? "" : ", ") + std::string(name);
+		}
+		throw mpm::InvalidParameter(attribute + " = '" + value + "' is not one of: " + valid);
+	}
+
+	const std::array<std::pair<const char*, mpm::ShapeFunction>, 3> shapeOptions {
+		{ { "linear", mpm::ShapeFunction::Linear }, { "uGIMP", mpm::ShapeFunction::UGimp }, { "cpGIMP", mpm::ShapeFunction::CpGimp } }
+	};
+	const std::array<std::pair<const char*, mpm::DragScheme>, 2> dragOptions { { { "semi-implicit", mpm::DragScheme::SemiImplicit },
+		                                                                       { "explicit", mpm::DragScheme::Explicit } } };
+	const std::array<std::pair<const char*, mpm::SolidWall>, 3> solidWallOptions {
+		{ { "free", mpm::SolidWall::Free }, { "slip", mpm::SolidWall::Slip }, { "fixed", mpm::SolidWall::Fixed } }
+	};
+	const std::array<std::pair<const char*, mpm::WaterWall>, 3> waterWallOptions {
+		{ { "free", mpm::WaterWall::Free }, { "impermeable", mpm::WaterWall::Impermeable }, { "drained", mpm::WaterWall::Drained } }
+	};
+
+	bool sameWater(const mpm::WaterParameters& a, const mpm::WaterParameters& b)
+	{
+		return a.density == b.density && a.bulkModulus == b.bulkModulus && a.viscosity == b.viscosity;
+	}
+} // namespace
+
 MpmTwoPhaseEngine::~MpmTwoPhaseEngine() = default;
+
+mpm::Domain MpmTwoPhaseEngine::domain() const
+{
+	mpm::Domain d;
+	d.lower    = domainMin;
+	d.upper    = domainMax;
+	d.cellSize = cellSize;
+	for (int f = 0; f < 6; ++f) {
+		auto& wall           = d.boundaries.walls[f];
+		wall.solid           = parseOption("solidWalls[" + std::string(faceNames[f]) + "]", solidWalls[f], solidWallOptions);
+		wall.water           = parseOption("waterWalls[" + std::string(faceNames[f]) + "]", waterWalls[f], waterWallOptions);
+		wall.drainedPressure = drainedPressure[f];
+		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + std::string(faceNames[f]) + "]", wall.drainedPressure, "Pa", "finite values");
+	}
+	for (int a = 0; a < 3; ++a)
+		if (!(domainMax[a] > domainMin[a])) mpm::throwOutOfRange("domainMax - domainMin", (domainMax - domainMin).transpose(), "m", "positive components");
+	return d;
+}
+
+mpm::SolverSettings MpmTwoPhaseEngine::settings() const
+{
+	mpm::SolverSettings s;
+	s.shapeFunction              = parseOption("shapeFunction", shapeFunction, shapeOptions);
+	s.drag                       = parseOption("drag", drag, dragOptions);
+	s.flipBlend                  = flipBlend;
+	s.timeStepFactor             = timeStepFactor;
+	s.gravity                    = gravity;
+	s.cellAveragedVolumetricRate = cellAveraging;
+	s.validate();
+	return s;
+}
 
 void MpmTwoPhaseEngine::action()
 {
 	const yade::Real dt = yade::abi::dt(scene);
-	long             solid = 0, water = 0;
+	if (!solver_) solver_ = std::make_unique<mpm::TwoPhaseSolver>(domain(), settings());
+
+	std::vector<mpm::SolidSet>       solids;
+	std::vector<mpm::WaterPointSet*> waters;
+	mpm::WaterParameters             water;
+	bool                             haveWater = false;
+	long                             solid = 0, fluid = 0;
 	for (const auto& body : yade::abi::bodies(scene)) {
 		if (!body) continue; // erased body
-		const auto& shape = yade::abi::shapeOf(body.get());
-		const int   id    = yade::abi::idOf(body.get());
+		const auto&       shape = yade::abi::shapeOf(body.get());
+		const std::string where = "O.bodies[" + std::to_string(yade::abi::idOf(body.get())) + "]";
 		if (auto* s = dynamic_cast<MpmSolidPoints*>(shape.get())) {
-			s->points.validate("O.bodies[" + std::to_string(id) + "].shape");
+			auto* mat = dynamic_cast<MpmSoilMat*>(yade::abi::materialOf(body.get()).get());
+			if (!mat) throw mpm::InvalidParameter(where + " carries MpmSolidPoints but its material is not an MpmSoilMat");
+			s->points.validate(where + ".shape");
+			solids.push_back(mpm::SolidSet { &s->points, mat->parameters() });
 			solid += static_cast<long>(s->points.size());
 		} else if (auto* w = dynamic_cast<MpmWaterPoints*>(shape.get())) {
-			w->points.validate("O.bodies[" + std::to_string(id) + "].shape");
-			water += static_cast<long>(w->points.size());
+			auto* mat = dynamic_cast<MpmWaterMat*>(yade::abi::materialOf(body.get()).get());
+			if (!mat) throw mpm::InvalidParameter(where + " carries MpmWaterPoints but its material is not an MpmWaterMat");
+			w->points.validate(where + ".shape");
+			const mpm::WaterParameters params = mat->parameters();
+			if (haveWater && !sameWater(params, water)) throw mpm::InvalidParameter(where + ": all water bodies must share one pore-water material (density, bulkModulus, viscosity)");
+			water     = params;
+			haveWater = true;
+			waters.push_back(&w->points);
+			fluid += static_cast<long>(w->points.size());
 		}
 	}
-	solidPointCount = solid;
-	waterPointCount = water;
-	lastDt          = dt;
-	lastIter        = yade::abi::iter(scene);
+	solver_->setPoints(std::move(solids), std::move(waters), water);
+	criticalTimeStep = solver_->timeStepLimits().critical;
+	subStepsLast     = solver_->advance(dt);
+	solverSteps      = solver_->stepCount();
+	solidPointCount  = solid;
+	waterPointCount  = fluid;
+	lastDt           = dt;
+	lastIter         = yade::abi::iter(scene);
 	mpmTime += dt;
 	++stepsDone;
 }
@@ -39,10 +126,10 @@ void MpmTwoPhaseEngine::action()
 void MpmTwoPhaseEngine::callPostLoad()
 {
 	yade::GlobalEngine::callPostLoad();
+	solver_.reset(); // any change of the set-up rebuilds the grid and the constraints
 	try {
-		mpm::requireOpenRange("timeStepFactor", timeStepFactor, 0, 1 + 1e-15, "");
-		mpm::requireClosedRange("flipBlend", flipBlend, 0, 1, "");
-		if (!gravity.allFinite()) mpm::throwOutOfRange("gravity", gravity.transpose(), "m s⁻²", "finite components");
+		settings();
+		domain();
 	} catch (const mpm::InvalidParameter& e) {
 		raisePython(PyExc_ValueError, "MpmTwoPhaseEngine: " + std::string(e.what()));
 	}
@@ -53,14 +140,27 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 	using E = MpmTwoPhaseEngine;
 	static const AttrTable<E> table {
 		vector3Attr("gravity", &E::gravity, "Gravitational acceleration acting on both phases b [m s⁻²]"),
-		realAttr("timeStepFactor", &E::timeStepFactor, "Safety factor C on the critical time step [-], 0 < C ≤ 1"),
+		realAttr("timeStepFactor", &E::timeStepFactor, "Safety factor C on the critical time step [-], 0 < C ≤ 1; O.dt is split into sub-steps no larger than C × criticalTimeStep"),
 		realAttr("flipBlend", &E::flipBlend, "FLIP/PIC blend α of the grid-to-point velocity update [-], 0 ≤ α ≤ 1 (1 = pure FLIP, 0 = PIC)"),
+		vector3Attr("domainMin", &E::domainMin, "Lower corner of the domain box, whose faces are the walls [m]"),
+		vector3Attr("domainMax", &E::domainMax, "Upper corner of the domain box; each extent a whole number of cells [m]"),
+		realAttr("cellSize", &E::cellSize, "Cell size h of the background grid (cubic cells) [m]"),
+		stringAttr("shapeFunction", &E::shapeFunction, "Shape functions [-]: 'linear', 'uGIMP' (constant point domains) or 'cpGIMP' (domains follow the stretch)"),
+		stringAttr("drag", &E::drag, "Drag integration [-]: 'semi-implicit' (no drag time-step limit) or 'explicit'"),
+		boolAttr("cellAveraging", &E::cellAveraging, "Cell-averaged volumetric rates for the pore pressure and the skeleton (suppresses the pressure checkerboard) [-]"),
+		fixedListAttr("solidWalls", &E::solidWalls, 6, "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0) or 'fixed'"),
+		fixedListAttr("waterWalls", &E::waterWalls, 6, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
+		fixedListAttr("drainedPressure", &E::drainedPressure, 6, "Pore pressure p̄ held on each 'drained' face [Pa]"),
 		readOnly(intAttr("stepsDone", &E::stepsDone, "Number of times the engine ran [-]")),
 		readOnly(realAttr("mpmTime", &E::mpmTime, "Total time the MPM state was advanced [s]")),
 		readOnly(intAttr("lastIter", &E::lastIter, "O.iter seen by the last run of the engine [-]")),
 		readOnly(realAttr("lastDt", &E::lastDt, "O.dt seen by the last run of the engine [s]")),
 		readOnly(intAttr("solidPointCount", &E::solidPointCount, "Solid points advanced by the last run [-]")),
 		readOnly(intAttr("waterPointCount", &E::waterPointCount, "Water points advanced by the last run [-]")),
+		readOnly(intAttr("subStepsLast", &E::subStepsLast, "Explicit sub-steps taken by the last run [-]")),
+		readOnly(intAttr("solverSteps", &E::solverSteps, "Explicit steps since the solver was (re)built [-]")),
+		readOnly(realAttr("criticalTimeStep", &E::criticalTimeStep,
+		                  "Critical time step of the last run before timeStepFactor: min of the wave limit h/(fastest wave + fastest point) and, with explicit drag, the drag limit [s]")),
 	};
 	return table;
 }
@@ -68,7 +168,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 void MpmTwoPhaseEngine::pyRegisterClass(py::object scope)
 {
 	registerPythonClass<MpmTwoPhaseEngine, yade::GlobalEngine>(
-	        scope, "Advances every MPM body of the scene (shapes MpmSolidPoints and MpmWaterPoints, materials MpmSoilMat and MpmWaterMat) by O.dt per step: the fully coupled two-phase material point method.");
+	        scope, "Advances every MPM body of the scene (shapes MpmSolidPoints and MpmWaterPoints, materials MpmSoilMat and MpmWaterMat) by O.dt per step: the fully coupled two-phase material point method on a regular grid over the box domainMin..domainMax, whose faces are walls with per-phase conditions.");
 }
 
 template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned int)
@@ -77,12 +177,24 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	serializeVector3(ar, "gravity", gravity);
 	ar& BOOST_SERIALIZATION_NVP(timeStepFactor);
 	ar& BOOST_SERIALIZATION_NVP(flipBlend);
+	serializeVector3(ar, "domainMin", domainMin);
+	serializeVector3(ar, "domainMax", domainMax);
+	ar& BOOST_SERIALIZATION_NVP(cellSize);
+	ar& BOOST_SERIALIZATION_NVP(shapeFunction);
+	ar& BOOST_SERIALIZATION_NVP(drag);
+	ar& BOOST_SERIALIZATION_NVP(cellAveraging);
+	ar& BOOST_SERIALIZATION_NVP(solidWalls);
+	ar& BOOST_SERIALIZATION_NVP(waterWalls);
+	ar& BOOST_SERIALIZATION_NVP(drainedPressure);
 	ar& BOOST_SERIALIZATION_NVP(stepsDone);
 	ar& BOOST_SERIALIZATION_NVP(mpmTime);
 	ar& BOOST_SERIALIZATION_NVP(lastIter);
 	ar& BOOST_SERIALIZATION_NVP(lastDt);
 	ar& BOOST_SERIALIZATION_NVP(solidPointCount);
 	ar& BOOST_SERIALIZATION_NVP(waterPointCount);
+	ar& BOOST_SERIALIZATION_NVP(subStepsLast);
+	ar& BOOST_SERIALIZATION_NVP(solverSteps);
+	ar& BOOST_SERIALIZATION_NVP(criticalTimeStep);
 }
 
 } // namespace yade_mpm

@@ -6,6 +6,10 @@
 #include "PyAttributes.hpp"
 #include "YadeAbi.hpp"
 
+#include "../core/TwoPhaseSolver.hpp"
+
+#include <memory>
+
 namespace yade_mpm {
 
 class MpmTwoPhaseEngine : public yade::GlobalEngine {
@@ -14,6 +18,15 @@ public:
 	yade::Vector3r gravity        = yade::Vector3r::Zero(); // b [m s⁻²], body acceleration of both phases
 	yade::Real     timeStepFactor = 0.5;                    // C [-] in (0, 1]: safety factor on the critical step
 	yade::Real     flipBlend      = 1.0;                    // α [-] in [0, 1]: 1 = FLIP, 0 = PIC
+	yade::Vector3r domainMin      = yade::Vector3r::Zero(); // lower corner of the domain box (walls) [m]
+	yade::Vector3r domainMax      = yade::Vector3r::Ones(); // upper corner [m]
+	yade::Real     cellSize       = 0.1;                    // h [m]
+	std::string    shapeFunction  = "uGIMP";                // linear | uGIMP | cpGIMP
+	std::string    drag           = "semi-implicit";        // semi-implicit | explicit
+	bool           cellAveraging  = true;                   // cell-averaged volumetric rates
+	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed
+	std::vector<std::string> waterWalls { 6, "free" };      // free | impermeable | drained
+	std::vector<yade::Real>  drainedPressure = std::vector<yade::Real>(6, 0.0); // p̄ per face [Pa]
 
 	// outputs (read-only from Python)
 	long       stepsDone       = 0; // number of times action() ran [-]
@@ -22,6 +35,9 @@ public:
 	yade::Real lastDt          = 0;  // O.dt seen by the last action() [s]
 	long       solidPointCount = 0;  // solid points advanced by the last action() [-]
 	long       waterPointCount = 0;  // water points advanced by the last action() [-]
+	long       subStepsLast    = 0;  // sub-steps of the last action() [-]
+	long       solverSteps     = 0;  // explicit steps since the solver was set up [-]
+	yade::Real criticalTimeStep = 0; // critical step of the last action(), before timeStepFactor [s]
 
 	MpmTwoPhaseEngine() = default;
 	~MpmTwoPhaseEngine() override;
@@ -30,6 +46,14 @@ public:
 	void pyRegisterClass(boost::python::object scope) override;
 	template <class Archive> void serialize(Archive& ar, unsigned int version);
 	MPM_SERIALIZABLE_OVERRIDES(MpmTwoPhaseEngine, GlobalEngine)
+
+	// Core objects built from the attributes (validated); rebuilt after any attribute change.
+	mpm::Domain         domain() const;
+	mpm::SolverSettings settings() const;
+	const mpm::TwoPhaseSolver* solver() const { return solver_.get(); }
+
+private:
+	std::unique_ptr<mpm::TwoPhaseSolver> solver_; // not serialized: rebuilt on first action()
 };
 
 } // namespace yade_mpm

@@ -78,6 +78,35 @@ template <class T> AttrSpec<T> vector3Attr(const char* name, yade::Vector3r T::*
 {
 	return { name, doc, [member](const T& s) { return py::object(s.*member); }, [member, name](T& s, const py::object& v) { s.*member = toVector3(name, v); } };
 }
+template <class T> AttrSpec<T> stringAttr(const char* name, std::string T::*member, const char* doc)
+{
+	return { name, doc, [member](const T& s) { return py::object(s.*member); }, [member, name](T& s, const py::object& v) {
+		        py::extract<std::string> x(v);
+		        if (!x.check()) raisePython(PyExc_TypeError, std::string("attribute '") + name + "' expects a string");
+		        s.*member = x();
+	        } };
+}
+// A fixed-length list (e.g. one entry per face of the domain box) of strings or reals.
+template <class T, class E> AttrSpec<T> fixedListAttr(const char* name, std::vector<E> T::*member, std::size_t length, const char* doc)
+{
+	return { name, doc,
+		 [member](const T& s) {
+			 py::list l;
+			 for (const auto& e : s.*member) l.append(e);
+			 return py::object(py::tuple(l));
+		 },
+		 [member, name, length](T& s, const py::object& v) {
+			 if (py::len(v) != static_cast<long>(length))
+				 raisePython(PyExc_ValueError, std::string("attribute '") + name + "' expects " + std::to_string(length) + " entries (xMin, xMax, yMin, yMax, zMin, zMax)");
+			 std::vector<E> out;
+			 for (std::size_t i = 0; i < length; ++i) {
+				 py::extract<E> x(v[i]);
+				 if (!x.check()) raisePython(PyExc_TypeError, std::string("attribute '") + name + "' has an entry of the wrong type at index " + std::to_string(i));
+				 out.push_back(x());
+			 }
+			 s.*member = out;
+		 } };
+}
 template <class T> AttrSpec<T> readOnly(AttrSpec<T> spec)
 {
 	spec.set = nullptr;

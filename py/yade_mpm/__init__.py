@@ -34,7 +34,7 @@ _yade_mpm.registerClasses(yade.wrapper)
 self_test(_yade_mpm, yade.wrapper, yade.wrapper.Omega())
 
 from yade.wrapper import MpmSoilMat, MpmSolidPoints, MpmTwoPhaseEngine, MpmWaterMat, MpmWaterPoints  # noqa: E402
-from . import builders  # noqa: E402
+from . import analytical, builders  # noqa: E402
 from .builders import saturated_block  # noqa: E402
 
 __version__ = _buildinfo.package_version

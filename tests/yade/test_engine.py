@@ -52,7 +52,7 @@ def test_counts_points_of_all_mpm_bodies_and_ignores_others():
 def test_bad_point_data_stops_before_any_work_with_a_clear_message():
     solid = w.MpmSolidPoints(pos=np.zeros((3, 3)))
     solid.mass = np.array([1.0, np.nan, 1.0])
-    O.bodies.append(w.Body(shape=solid))
+    O.bodies.append(w.Body(shape=solid, material=w.MpmSoilMat()))
     O.engines = [w.MpmTwoPhaseEngine(label="mpm")]
     with pytest.raises(ValueError, match=r"O.bodies\[0\].shape.mass\[1\] = nan kg is outside the valid range"):
         O.step()

@@ -1,0 +1,93 @@
+"""End-to-end physics through YADE: the engine in O.engines advances real MPM states."""
+import numpy as np
+import pytest
+
+import yade.wrapper as w
+from yade import O
+
+import yade_mpm
+from yade_mpm import analytical
+
+G = np.array([0.0, 0.0, -9.81])
+
+
+def column(height, cell, permeability=1e-10, bulk_modulus=2.2e8, geostatic=True):
+    soil = w.MpmSoilMat(density=2650, youngModulus=20e6, poissonRatio=0.3, porosity=0.4, intrinsicPermeability=permeability)
+    water = w.MpmWaterMat(density=1000, bulkModulus=bulk_modulus, viscosity=1e-3)
+    O.materials.append([soil, water])
+    solid, fluid = yade_mpm.saturated_block((0, 0, 0), (cell, cell, height), cell, soil, water, points_per_cell=2,
+                                            gravity=G, geostatic=geostatic)
+    O.bodies.append([solid, fluid])
+    engine = w.MpmTwoPhaseEngine(label="mpm", gravity=G, domainMin=(0, 0, 0), domainMax=(cell, cell, height), cellSize=cell,
+                                 solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("drained",))
+    O.engines = [engine]
+    return soil, water, solid.shape, fluid.shape, engine
+
+
+def test_hydrostatic_column_stays_at_rest():
+    """p = γw d within h/(4H) of γw H (the drained top layer is held at 0, h/4 below the surface),
+    σ′_zz = −(ρsat − ρw) g d within 1%, speeds negligible, each phase's mass unchanged."""
+    height, cell = 1.0, 0.1
+    soil, water, solid, fluid, engine = column(height, cell)
+    masses = (solid.mass.sum(), fluid.mass.sum())
+    O.dt = 1e-3
+    O.run(40, True)
+    g = 9.81
+    rho_sat = 0.6 * 2650 + 0.4 * 1000
+    p_err = np.abs(fluid.porePressure - 1000 * g * (height - fluid.pos[:, 2])).max() / (1000 * g * height)
+    s_err = np.abs(solid.stress[:, 2, 2] + (rho_sat - 1000) * g * (height - solid.pos[:, 2])).max() / ((rho_sat - 1000) * g * height)
+    assert p_err <= cell / (4 * height) + 1e-9
+    assert s_err < 0.01
+    # a 1 mm/s drift over 0.04 s would move points 40 µm: far beyond the static solution
+    assert np.linalg.norm(solid.vel, axis=1).max() < 1e-5
+    assert np.linalg.norm(fluid.vel, axis=1).max() < 1e-5
+    assert (solid.mass.sum(), fluid.mass.sum()) == masses  # exactly
+    assert engine.subStepsLast >= 1 and engine.mpmTime == pytest.approx(0.04)
+
+
+def test_engine_sub_steps_to_the_critical_time_step():
+    soil, water, solid, fluid, engine = column(0.5, 0.05)
+    O.dt = 1e-3
+    O.step()
+    wave = analytical.undrained_wave_speed(20e6, 0.3, 0.4, 2650, 1000, 2.2e8)
+    # critical step is h over the fastest wave (the undrained P wave here; points at rest)
+    assert engine.criticalTimeStep == pytest.approx(0.05 / wave, rel=1e-9)
+    assert engine.subStepsLast == int(np.ceil(1e-3 / (engine.timeStepFactor * engine.criticalTimeStep)))
+
+
+def test_gravity_loading_from_stress_free_start_settles_towards_geostatic():
+    """Started stress-free, the column compresses under its buoyant weight: the base effective
+    stress approaches −(ρsat − ρw) g H as the drained column consolidates."""
+    soil, water, solid, fluid, engine = column(0.4, 0.05, permeability=1e-9, geostatic=False)
+    O.dt = 2e-3
+    O.run(100, True)
+    base = solid.pos[:, 2] < 0.05
+    target = -(0.6 * 2650 + 0.4 * 1000 - 1000) * 9.81 * (0.4 - solid.pos[base, 2])
+    total = -(0.6 * 2650 + 0.4 * 1000) * 9.81 * (0.4 - solid.pos[base, 2])
+    sigma = solid.stress[base, 2, 2]
+    assert np.all(sigma < 0.5 * target)  # well into compression
+    assert np.all(sigma > 1.1 * total)   # never more than the total weight
+
+
+def test_python_and_cpp_analytical_solutions_agree():
+    # reference values of doc/theory.md §5.1 (computed with 200 terms)
+    assert analytical.terzaghi_pressure_ratio(0.5, 0.2) == pytest.approx(0.5532, abs=1e-4)
+    assert analytical.terzaghi_pressure_ratio(1.0, 0.5) == pytest.approx(0.3708, abs=1e-4)
+    assert analytical.terzaghi_degree(0.2) == pytest.approx(0.5041, abs=1e-4)
+    assert analytical.terzaghi_degree(1.0) == pytest.approx(0.9313, abs=1e-4)
+
+
+def test_points_leaving_the_grid_stop_the_run_with_a_clear_message():
+    """A block thrown upwards out of its domain stops the run at the step it leaves, naming the
+    set, the point and its position; no non-finite value is left in the points."""
+    soil, water, solid, fluid, engine = column(0.2, 0.05)
+    engine.domainMax = (0.05, 0.05, 0.3)
+    engine.solidWalls = ("slip",) * 4 + ("free", "free")
+    engine.waterWalls = ("impermeable",) * 4 + ("free", "free")
+    solid.vel = np.tile([0.0, 0.0, 40.0], (solid.count, 1))
+    fluid.vel = np.tile([0.0, 0.0, 40.0], (fluid.count, 1))
+    engine.gravity = (0, 0, 0)
+    O.dt = 1e-4
+    with pytest.raises(RuntimeError, match=r"at step \d+: (solid|water) set 0, point \d+ at \(.*\) m is outside the grid"):
+        O.run(100, True)
+    assert np.isfinite(solid.pos).all() and np.isfinite(fluid.porePressure).all()
