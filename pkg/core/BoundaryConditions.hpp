@@ -1,4 +1,4 @@
-// Boundary conditions per phase on the walls of the domain box (doc/theory.md §2.3). Walls lie on
+// Boundary conditions per phase on the walls of the domain box (doc/theory.md §2). Walls lie on
 // the grid's node planes at the box faces; a condition applies to the wall plane and to the
 // padding nodes beyond it.
 #pragma once
@@ -19,7 +19,7 @@ enum class WaterWall {
 	Free,        // no condition on the water (natural: zero pressure traction, weakly enforced)
 	Impermeable, // normal water velocity 0 (tangential water flow free)
 	Drained,     // water crosses freely; pore pressure held at drainedPressure on the water
-	             // points whose GIMP domain reaches the face or lies beyond it (theory.md §2.3)
+	             // points whose GIMP domain reaches the face or lies beyond it (theory.md §2)
 };
 
 struct WallConditions {
@@ -44,7 +44,7 @@ struct NodeConstraint {
 NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& bcs, int i, int j, int k);
 
 struct WaterPointSet;
-// Hold the pore pressure of water points at Drained faces (theory.md §2.3, eq. 2.1).
+// Hold the pore pressure of water points at Drained faces (theory.md §2, eq. 2.1).
 void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, WaterPointSet& points);
 
 } // namespace mpm

@@ -1,4 +1,4 @@
-// Regular Cartesian background grid and its nodal fields (doc/theory.md §2.2).
+// Regular Cartesian background grid and its nodal fields (doc/theory.md §4).
 #pragma once
 
 #include "Types.hpp"

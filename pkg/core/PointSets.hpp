@@ -1,5 +1,5 @@
 // Material point sets in structure-of-arrays form: one contiguous array per field, so that the
-// stages stream through memory and OpenMP splits them by index (doc/theory.md §2.1).
+// stages stream through memory and OpenMP splits them by index (doc/theory.md §4).
 #pragma once
 
 #include "Types.hpp"

@@ -212,7 +212,7 @@ namespace stages {
 			fields.solidVelocityNew[i] = vsNew;
 			fields.waterVelocityNew[i] = vwNew;
 		}
-		// Walls (theory.md §2.3): a held component is zero; the other phase's free component is
+		// Walls (theory.md §2): a held component is zero; the other phase's free component is
 		// then re-solved with it known (water: drag to the held solid; solid: mixture momentum).
 		const std::size_t count = constrained.node.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)

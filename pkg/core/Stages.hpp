@@ -14,8 +14,8 @@
 namespace mpm {
 
 enum class DragScheme {
-	SemiImplicit, // drag implicit per node (theory.md eq. 4.6): no drag time-step limit
-	Explicit,     // drag explicit (theory.md eq. 4.4): Δt < 2/λ, see criticalTimeStep
+	SemiImplicit, // drag implicit per node (theory.md eq. 4.10): no drag time-step limit
+	Explicit,     // drag explicit (theory.md eq. 4.9): Δt < 2/λ (eq. 5.2)
 };
 
 // A set of solid points and the parameters of its material.

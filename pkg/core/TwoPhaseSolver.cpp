@@ -86,7 +86,7 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 	solids_ = std::move(solids);
 	waters_ = std::move(waters);
 	water_  = water;
-	// a node is "empty" below a billionth of the lightest point's mass (theory.md §2.2 step 5)
+	// a node is "empty" below a billionth of the lightest point's mass (theory.md §4, step 5)
 	solidMassTolerance_ = std::isfinite(minSolid) ? 1e-9 * minSolid : 0;
 	waterMassTolerance_ = std::isfinite(minWater) ? 1e-9 * minWater : 0;
 	throwIfOutsideGrid();
@@ -113,7 +113,7 @@ TimeStepLimits TwoPhaseSolver::timeStepLimits() const
 				const Real kappa  = set.kozenyCarman ? s.intrinsicPermeability * (nMax * nMax * nMax / ((1 - nMax) * (1 - nMax))) / (n * n * n / ((1 - n) * (1 - n))) : s.intrinsicPermeability;
 				const Real Q      = nMax * nMax * water_.viscosity / std::min(kappa, s.intrinsicPermeability);
 				const Real lambda = Q * (1 / (nMax * rhoW) + 1 / ((1 - nMax) * s.density));
-				dragLimit         = std::min(dragLimit, 2 / lambda); // theory.md eq. 4.5
+				dragLimit         = std::min(dragLimit, 2 / lambda); // theory.md eq. 5.2
 			}
 		}
 		for (const Vec3& v : set.points->velocity) pointSpeed = std::max(pointSpeed, v.norm());

@@ -29,7 +29,7 @@ struct Domain {
 	BoundaryConditions boundaries;
 };
 
-// Time-step limits of the current state (theory.md §4.1–4.2), before the safety factor.
+// Time-step limits of the current state (theory.md §5, eqs. 5.1–5.2), before the safety factor.
 struct TimeStepLimits {
 	Real wave;     // h / fastest wave (+ fastest point) [s]
 	Real drag;     // 2/λ of the explicit drag; infinity with semi-implicit drag [s]

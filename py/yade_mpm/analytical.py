@@ -1,4 +1,4 @@
-"""Closed-form solutions the examples and tests compare against (doc/theory.md §5).
+"""Closed-form solutions the examples and tests compare against (doc/theory.md §6).
 
 The same formulas live in C++ for the core tests (tests/support/AnalyticalSolutions.hpp);
 tests/yade/test_physics.py checks that both agree.

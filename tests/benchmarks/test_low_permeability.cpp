@@ -1,4 +1,4 @@
-// Low permeability (k = 1e-8 m/s): the explicit drag limit Δt < 2/λ (theory.md eq. 4.5) is far
+// Low permeability (k = 1e-8 m/s): the explicit drag limit Δt < 2/λ (theory.md eq. 5.2) is far
 // below the wave limit. With the semi-implicit drag (eq. 4.10) a saturated column under gravity
 // runs stably at the wave time step and stays at rest; with explicit drag at the same step the
 // relative velocity is amplified by |1 − λΔt| > 1 each step and the solver stops with an

@@ -1,4 +1,4 @@
-// Terzaghi 1D consolidation (doc/theory.md §5.1): a column with drained top and impermeable base
+// Terzaghi 1D consolidation (doc/theory.md §6.1): a column with drained top and impermeable base
 // under a sudden total load q, started from the undrained state the analytical solution assumes
 // (p = p0 = q (Kw/n)/(E_oed + Kw/n), σ′_zz = −(q − p0)). Compressible water enters through c_v and p0.
 #include "core/TwoPhaseSolver.hpp"

@@ -1,4 +1,4 @@
-// Closed-form solutions the benchmarks are checked against (doc/theory.md §5).
+// Closed-form solutions the benchmarks are checked against (doc/theory.md §6).
 #pragma once
 
 #include <cmath>

@@ -70,7 +70,7 @@ def test_gravity_loading_from_stress_free_start_settles_towards_geostatic():
 
 
 def test_python_and_cpp_analytical_solutions_agree():
-    # reference values of doc/theory.md §5.1 (computed with 200 terms)
+    # reference values of doc/theory.md §6.1 (computed with 200 terms)
     assert analytical.terzaghi_pressure_ratio(0.5, 0.2) == pytest.approx(0.5532, abs=1e-4)
     assert analytical.terzaghi_pressure_ratio(1.0, 0.5) == pytest.approx(0.3708, abs=1e-4)
     assert analytical.terzaghi_degree(0.2) == pytest.approx(0.5041, abs=1e-4)
