@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Throughput benchmark (not a test): builds, then times a saturated 3D two-phase uGIMP block at
+# about 1e4, 1e5 and 1e6 soil points with 1 and 2 threads (median of repeated runs) and writes
+# the table to doc/benchmarks.md (section between the BENCH markers).
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+build="${MPM_BUILD_DIR:-$root/build}"
+if [ ! -x "$build/mpm_bench" ]; then "$root/scripts/build.sh"; fi
+cmake --build "$build" -j 2 --target mpm_bench > /dev/null
+rows=$(mktemp)
+#        cells/side steps repeats
+for config in "11 20 9" "23 4 7" "50 2 5"; do
+  for threads in 1 2; do
+    OMP_NUM_THREADS=$threads "$build/mpm_bench" $config >> "$rows"
+  done
+done
+machine="$(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(date -u +%Y-%m-%d)"
+/usr/bin/python3 - "$rows" "$root/doc/benchmarks.md" "$machine" <<'PY'
+import sys, re
+rows = [l.split("\t") for l in open(sys.argv[1]).read().splitlines() if l.strip()]
+single = {r[0]: float(r[2]) for r in rows if r[1] == "1"}
+lines = ["Measured on %s. Median of the repeats; soil point = one solid + one water point." % sys.argv[3], "",
+         "| soil points | threads | soil point-steps/s | per thread | speed-up | memory [B/soil point] |", "|---|---|---|---|---|---|"]
+for r in rows:
+    lines.append("| %s | %s | %.3g | %.3g | %.2f | %s |" % (r[0], r[1], float(r[2]), float(r[3]), float(r[2]) / single[r[0]], r[4]))
+lines += ["", "Share of the step per stage [%] (rows as above):", "",
+          "| soil points | threads | " + " | ".join(kv.split("=")[0] for kv in rows[0][5:]) + " |",
+          "|---|---|" + "---|" * len(rows[0][5:])]
+for r in rows:
+    lines.append("| %s | %s | " % (r[0], r[1]) + " | ".join(kv.split("=")[1] for kv in r[5:]) + " |")
+doc = open(sys.argv[2]).read()
+doc = re.sub(r"<!-- BENCH -->.*<!-- /BENCH -->", "<!-- BENCH -->\n" + "\n".join(lines) + "\n<!-- /BENCH -->", doc, flags=re.S)
+open(sys.argv[2], "w").write(doc)
+print("\n".join(lines))
+PY
+rm -f "$rows"
