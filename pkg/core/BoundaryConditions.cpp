@@ -1,6 +1,7 @@
 #include "BoundaryConditions.hpp"
 
 #include "PointSets.hpp"
+#include "Grid.hpp"
 
 namespace mpm {
 
@@ -19,6 +20,36 @@ NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& 
 		}
 	}
 	return c;
+}
+
+void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, Real waterMassTolerance, GridFields& fields)
+{
+	const Real h = grid.cellSize;
+	for (int face = 0; face < faceCount; ++face) {
+		const WallConditions& wall = bcs.walls[face];
+		if (wall.water != WaterWall::Drained || wall.drainedPressure == 0) continue;
+		const int  axis = face / 2, a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+		const bool upperFace = face % 2 == 1;
+		const int  plane     = upperFace ? grid.upperWallNode[axis] : grid.wallNode[axis];
+		Vec3       inward    = Vec3::Zero();
+		inward[axis]         = upperFace ? -1 : 1;
+		// ∫ N dA over the face: h per in-plane axis inside the box, h/2 on its edges
+		auto share = [&](int d, int i) { return i < grid.wallNode[d] || i > grid.upperWallNode[d] ? 0.0 : (i == grid.wallNode[d] || i == grid.upperWallNode[d] ? h / 2 : h); };
+		for (int j = 0; j < grid.nodes[a1]; ++j)
+			for (int k = 0; k < grid.nodes[a2]; ++k) {
+				const Real area = share(a1, j) * share(a2, k);
+				if (area == 0) continue;
+				int idx[3];
+				idx[axis] = plane;
+				idx[a1]   = j;
+				idx[a2]   = k;
+				const std::size_t I = grid.index(idx[0], idx[1], idx[2]);
+				if (!(fields.water[I].mass > waterMassTolerance)) continue;
+				const Vec3 traction = wall.drainedPressure * area * inward;
+				fields.water[I].porousForce += fields.porosity[I] * traction;
+				fields.water[I].pressureForce += traction;
+			}
+	}
 }
 
 void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, WaterPointSet& points)

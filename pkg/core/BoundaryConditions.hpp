@@ -44,6 +44,11 @@ struct NodeConstraint {
 NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& bcs, int i, int j, int k);
 
 struct WaterPointSet;
+struct GridFields;
+// The boundary terms of a Drained face with p̄ ≠ 0 (theory.md eq. 2.2): −∮ N n p̄ n̂ dA on the
+// water and −∮ N p̄ n̂ dA on the mixture, at the wall-plane nodes that carry water.
+void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, Real waterMassTolerance, GridFields& fields);
+
 // Hold the pore pressure of water points at Drained faces (theory.md §2, eq. 2.1).
 void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, WaterPointSet& points);
 

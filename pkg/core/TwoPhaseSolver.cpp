@@ -163,6 +163,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	{
 		StageTimer t(stageSeconds_, Stage::MapWaterToGrid);
 		mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_);
+		addDrainedFaceTractions(grid_, domain_.boundaries, waterMassTolerance_, fields_);
 	}
 	{
 		StageTimer t(stageSeconds_, Stage::IntegrateNodalMomentum);
