@@ -1,6 +1,7 @@
 // Entry points of the plugin: registration in YADE's class factory when the library is loaded
 // (both at YADE boot and at `import yade_mpm`), and the Python extension module `_yade_mpm`,
 // whose import registers the classes in yade.wrapper and builtins.
+#include "MpmHdf5Recorder.hpp"
 #include "MpmMaterials.hpp"
 #include "MpmPointShapes.hpp"
 #include "MpmTwoPhaseEngine.hpp"
@@ -28,8 +29,9 @@ namespace {
 			registerInFactory<MpmWaterPoints>("MpmWaterPoints");
 			registerInFactory<MpmSoilMat>("MpmSoilMat");
 			registerInFactory<MpmWaterMat>("MpmWaterMat");
+			registerInFactory<MpmHdf5Recorder>("MpmHdf5Recorder");
 			static const char* fileAndClasses[]
-			        = { __FILE__, "MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat", nullptr };
+			        = { __FILE__, "MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat", "MpmHdf5Recorder", nullptr };
 			Singleton<yade::ClassFactory>::instance().registerPluginClasses(fileAndClasses);
 		}
 	};
@@ -42,6 +44,7 @@ namespace {
 		MpmWaterPoints {}.pyRegisterClass(scope);
 		MpmSoilMat {}.pyRegisterClass(scope);
 		MpmWaterMat {}.pyRegisterClass(scope);
+		MpmHdf5Recorder {}.pyRegisterClass(scope);
 	}
 
 	// Read, at the mirrored offsets, values that Python has just set through YADE's own accessors.

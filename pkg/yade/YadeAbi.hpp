@@ -227,6 +227,7 @@ namespace abi {
 	constexpr std::size_t sceneDt                = 0x1b8; // Real
 	constexpr std::size_t sceneIter              = 0x1c0; // long
 	constexpr std::size_t sceneTime              = 0x1d0; // Real
+	constexpr std::size_t sceneEngines           = 0x228; // vector<shared_ptr<Engine>>
 	constexpr std::size_t sceneBodies            = 0x258; // shared_ptr<BodyContainer>
 	constexpr std::size_t bodyContainerBodies    = 0x18;  // vector<shared_ptr<Body>>, null = erased
 	constexpr std::size_t bodyId                 = 0x18;  // int
@@ -240,6 +241,7 @@ namespace abi {
 	inline Real&       dt(Scene* s) { return at<Real>(s, sceneDt); }
 	inline long&       iter(Scene* s) { return at<long>(s, sceneIter); }
 	inline Real&       time(Scene* s) { return at<Real>(s, sceneTime); }
+	inline const auto& engines(Scene* s) { return at<std::vector<boost::shared_ptr<Engine>>>(s, sceneEngines); }
 	inline const auto& bodies(Scene* s)
 	{
 		const auto& container = at<boost::shared_ptr<BodyContainer>>(s, sceneBodies);

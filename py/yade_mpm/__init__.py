@@ -33,10 +33,10 @@ from . import _yade_mpm  # noqa: E402  (only after the guard: loading it trusts 
 _yade_mpm.registerClasses(yade.wrapper)
 self_test(_yade_mpm, yade.wrapper, yade.wrapper.Omega())
 
-from yade.wrapper import MpmSoilMat, MpmSolidPoints, MpmTwoPhaseEngine, MpmWaterMat, MpmWaterPoints  # noqa: E402
-from . import analytical, builders  # noqa: E402
+from yade.wrapper import MpmHdf5Recorder, MpmSoilMat, MpmSolidPoints, MpmTwoPhaseEngine, MpmWaterMat, MpmWaterPoints  # noqa: E402
+from . import analytical, builders, results  # noqa: E402
 from .builders import saturated_block  # noqa: E402
 
 __version__ = _buildinfo.package_version
-__all__ = ["MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat", "YadeAbiMismatch",
+__all__ = ["MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat", "MpmHdf5Recorder", "YadeAbiMismatch",
            "saturated_block"]

@@ -8,7 +8,7 @@ from conftest import YADE, env_without_build_tree, run_script
 from yade import O
 from yade.wrapper import Engine, GlobalEngine, Material, Serializable, Shape
 
-CLASSES = ["MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat"]
+CLASSES = ["MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat", "MpmHdf5Recorder"]
 
 CHECK = """
 import builtins, yade.wrapper

@@ -1,0 +1,84 @@
+"""MpmHdf5Recorder writes what the points hold, an XDMF index that points at real datasets, and
+never a non-finite value; yade_mpm.results reads it back."""
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+import pytest
+
+import yade.wrapper as w
+from yade import O
+
+import yade_mpm
+from yade_mpm import results
+
+G = (0.0, 0.0, -9.81)
+
+
+def scene(tmp_path, period):
+    soil, water = w.MpmSoilMat(), w.MpmWaterMat(bulkModulus=2.2e8)
+    O.materials.append([soil, water])
+    solid, fluid = yade_mpm.saturated_block((0, 0, 0), (0.1, 0.1, 0.3), 0.05, soil, water, gravity=G)
+    O.bodies.append([solid, fluid])
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm", gravity=G, domainMin=(0, 0, 0), domainMax=(0.1, 0.1, 0.3), cellSize=0.05,
+                                     solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("drained",)),
+                 w.MpmHdf5Recorder(label="recorder", file=str(tmp_path / "run.h5"), iterPeriod=period)]
+    O.dt = 1e-4
+    return solid.shape, fluid.shape
+
+
+def test_records_read_back_exactly(tmp_path):
+    solid, fluid = scene(tmp_path, 5)
+    O.run(16, True)
+    records = results.read(str(tmp_path / "run.h5"))
+    assert [r.iteration for r in records] == [0, 5, 10, 15]
+    assert records[-1].time == pytest.approx(16 * 1e-4)  # recorded after the MPM step of iteration 15
+    last = records[-1]
+    s, f = last.sets["solid_0"], last.sets["water_1"]
+    assert np.array_equal(s["position"], solid.pos) and np.array_equal(s["velocity"], solid.vel)
+    assert np.array_equal(s["stress"], solid.stress) and np.array_equal(s["porosity"], solid.porosity)
+    assert np.array_equal(f["porePressure"], fluid.porePressure) and np.array_equal(f["position"], fluid.pos)
+    grid = last.grid
+    assert grid["solidMass"].shape == (6 + 3, 2 + 3, 2 + 3)  # (nz, ny, nx): domain cells + 3 nodes per axis
+    assert grid["solidVelocity"].shape == (9, 5, 5, 3)
+    assert grid["solidMass"].sum() == pytest.approx(solid.mass.sum(), rel=1e-12)  # P2G conserves mass
+    assert np.allclose(grid["origin"], [-0.05, -0.05, -0.05]) and grid["spacing"] == 0.05
+    assert O.engines[1].records == 4
+
+
+def test_xdmf_index_points_at_existing_datasets_with_matching_shapes(tmp_path):
+    scene(tmp_path, 3)
+    O.run(7, True)
+    tree = ET.parse(str(tmp_path / "run.xmf"))
+    times = [float(t.get("Value")) for t in tree.iter("Time")]
+    assert len(times) == 3 and times == sorted(times)
+    items = [d for d in tree.iter("DataItem") if d.get("Format") == "HDF"]
+    assert len(items) > 10
+    with h5py.File(str(tmp_path / "run.h5"), "r") as f:
+        for item in items:
+            filename, path = item.text.split(":")
+            assert filename == "run.h5"
+            dims = [int(x) for x in item.get("Dimensions").split()]
+            assert int(np.prod(f[path].shape)) == int(np.prod(dims)), path
+
+
+def test_non_finite_values_are_refused_and_earlier_records_survive(tmp_path):
+    solid, fluid = scene(tmp_path, 1)
+    O.engines = [O.engines[1]]  # the recorder alone: nothing else checks the points
+    O.run(2, True)
+    p = fluid.porePressure
+    p[3] = np.nan
+    fluid.porePressure = p
+    with pytest.raises(RuntimeError, match=r"refusing to record a non-finite value: water_1/porePressure row 3"):
+        O.run(1, True)
+    records = results.read(str(tmp_path / "run.h5"))
+    assert len(records) == 2 and all(np.isfinite(r.sets["water_1"]["porePressure"]).all() for r in records)
+
+
+def test_recorder_attributes_and_period_validation(tmp_path):
+    with pytest.raises(ValueError, match=r"iterPeriod = 0 is outside the valid range"):
+        w.MpmHdf5Recorder(iterPeriod=0)
+    with pytest.raises(RuntimeError, match="cannot create"):
+        scene(tmp_path, 1)
+        O.engines[1].file = str(tmp_path / "missing" / "dir" / "run.h5")
+        O.step()
