@@ -62,6 +62,8 @@ const AttrTable<MpmSoilMat>& MpmSoilMat::attributes()
 		realAttr("porosity", &M::porosity, "Initial porosity n0 [-], in (0, 1)"),
 		realAttr("intrinsicPermeability", &M::intrinsicPermeability,
 		         "Intrinsic permeability κ [m²], > 0; the hydraulic conductivity is k = κ ρw |g| / μw [m s⁻¹] with the engine's gravity"),
+		boolAttr("kozenyCarman", &M::kozenyCarman,
+		         "Let the permeability follow the porosity, κ(n) = κ [n³/(1−n)²]/[n0³/(1−n0)²] with n0 = porosity (theory.md eq. 1.7) [-]"),
 	};
 	return table;
 }
@@ -96,6 +98,7 @@ template <class Archive> void MpmSoilMat::serialize(Archive& ar, unsigned int)
 	ar& BOOST_SERIALIZATION_NVP(poissonRatio);
 	ar& BOOST_SERIALIZATION_NVP(porosity);
 	ar& BOOST_SERIALIZATION_NVP(intrinsicPermeability);
+	ar& BOOST_SERIALIZATION_NVP(kozenyCarman);
 }
 
 template <class Archive> void MpmWaterMat::serialize(Archive& ar, unsigned int)

@@ -16,6 +16,7 @@ public:
 	yade::Real poissonRatio          = mpm::SoilParameters {}.poissonRatio;          // ν [-]
 	yade::Real porosity              = mpm::SoilParameters {}.porosity;              // n0 [-]
 	yade::Real intrinsicPermeability = mpm::SoilParameters {}.intrinsicPermeability; // κ [m²]
+	bool       kozenyCarman          = false; // κ(n) by the Kozeny–Carman ratio
 
 	MpmSoilMat()
 	{

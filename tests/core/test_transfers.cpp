@@ -68,6 +68,33 @@ TEST(ParticleToGrid, ConservesMassAndMomentumOfEachPhase)
 	EXPECT_LT((gPW - pW).norm(), 1e-12 * mW);
 }
 
+TEST(ParticleToGrid, DragCoefficientFollowsDarcyAndKozenyCarman)
+{
+	// Σ_I Q_I = Σ_p V n² μw/κ(n) (partition of unity), with κ(n) = κ0 [n³/(1−n)²]/[n0³/(1−n0)²]
+	std::mt19937_64 rng(5);
+	Box             box;
+	SolidPointSet   solid = randomSolid(300, rng);
+	std::uniform_real_distribution<Real> porosity(0.3, 0.5);
+	for (auto& n : solid.porosity) n = porosity(rng);
+	SoilParameters  soil;
+	WaterParameters water;
+	for (bool kc : { false, true }) {
+		std::vector<SolidSet> sets { SolidSet { &solid, soil, kc } };
+		ScatterWorkspace      ws;
+		stages::resetGrid(box.fields);
+		stages::mapSolidToGrid<GimpKernel>(box.grid, sets, water, Vec3::Zero(), box.fields, ws);
+		Real expected = 0, total = 0;
+		const Real n0 = soil.porosity;
+		for (std::size_t p = 0; p < solid.size(); ++p) {
+			const Real n     = solid.porosity[p];
+			const Real kappa = soil.intrinsicPermeability * (kc ? (n * n * n / ((1 - n) * (1 - n))) / (n0 * n0 * n0 / ((1 - n0) * (1 - n0))) : 1.0);
+			expected += solid.volume[p] * n * n * water.viscosity / kappa;
+		}
+		for (const auto& node : box.fields.solid) total += node.drag;
+		EXPECT_NEAR(total, expected, 1e-12 * expected) << (kc ? "Kozeny-Carman" : "constant permeability");
+	}
+}
+
 TEST(GridToParticle, LinearFieldIsInterpolatedExactly)
 {
 	std::mt19937_64 rng(11);

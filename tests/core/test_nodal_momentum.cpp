@@ -1,0 +1,111 @@
+// The nodal momentum stage (theory.md eqs. 4.8–4.10, 5.2): the [DERIVED] properties of the
+// semi-implicit drag, the explicit drag's stability limit, and wall re-solves.
+#include "core/Stages.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace {
+
+using namespace mpm;
+
+// One node carrying both phases, with forces and velocities; no walls.
+struct OneNode {
+	GridFields       fields;
+	ConstrainedNodes none;
+	OneNode(Real ms, Real mw, Real Q, const Vec3& vs, const Vec3& vw, const Vec3& fSolid, const Vec3& fWater)
+	{
+		fields.resize(1);
+		fields.solid[0]         = SolidNode { ms, ms * vs, fSolid, 1, 0.6, Q };
+		fields.water[0]         = WaterNode { mw, mw * vw, Vec3::Zero(), fWater, Vec3::Zero() };
+		fields.solidVelocity[0] = vs;
+		fields.waterVelocity[0] = vw;
+	}
+	void step(Real dt, DragScheme drag) { stages::integrateNodalMomentum(fields, none, dt, drag, 1e-12, 1e-12); }
+};
+
+const Vec3 vs0(0.1, -0.2, 0.3), vw0(-0.4, 0.5, 0.05), fs(3, -1, 2), fw(-2, 4, 1);
+
+TEST(SemiImplicitDrag, WithoutDragGivesTheUncoupledUpdates)
+{
+	OneNode n(2.0, 0.5, 0.0, vs0, vw0, fs, fw);
+	n.step(1e-3, DragScheme::SemiImplicit);
+	// here f^m = fs (no pressure force or water weight) and f^w = fw: water alone v^w + Δt f^w/m^w,
+	// solid by mixture minus water momentum, v^s + Δt (f^m − f^w)/m^s
+	EXPECT_LT((n.fields.waterVelocityNew[0] - (vw0 + 1e-3 * fw / 0.5)).norm(), 1e-15);
+	EXPECT_LT((n.fields.solidVelocityNew[0] - (vs0 + 1e-3 * (fs - fw) / 2.0)).norm(), 1e-15);
+}
+
+TEST(SemiImplicitDrag, InfiniteDragGivesBothPhasesTheMixtureVelocity)
+{
+	OneNode n(2.0, 0.5, 1e15, vs0, vw0, fs, fw);
+	n.step(1e-3, DragScheme::SemiImplicit);
+	const Vec3 mixture = (2.0 * vs0 + 0.5 * vw0 + 1e-3 * fs) / 2.5; // (m^s v^s + m^w v^w + Δt f^m)/(m^s + m^w)
+	EXPECT_LT((n.fields.waterVelocityNew[0] - mixture).norm(), 1e-9);
+	EXPECT_LT((n.fields.solidVelocityNew[0] - mixture).norm(), 1e-9);
+}
+
+TEST(SemiImplicitDrag, ConservesMixtureMomentumAndSatisfiesTheImplicitWaterEquation)
+{
+	for (Real Q : { 0.3, 30.0, 3e4 }) {
+		OneNode      n(2.0, 0.5, Q, vs0, vw0, fs, fw);
+		const Real   dt = 1e-3;
+		n.step(dt, DragScheme::SemiImplicit);
+		const Vec3& vs = n.fields.solidVelocityNew[0];
+		const Vec3& vw = n.fields.waterVelocityNew[0];
+		// mixture: m^s Δv^s + m^w Δv^w = Δt f^m
+		EXPECT_LT((2.0 * (vs - vs0) + 0.5 * (vw - vw0) - dt * fs).norm(), 1e-12);
+		// water, drag at t^{n+1}: m^w Δv^w = Δt (f^w − Q (v^w+ − v^s+))
+		EXPECT_LT((0.5 * (vw - vw0) - dt * (fw - Q * (vw - vs))).norm(), 1e-12);
+	}
+}
+
+// With drag only, the relative velocity w = v^w − v^s obeys w ← (1 − λΔt) w under explicit drag,
+// λ = Q (1/m^w + 1/m^s): stable (|1 − λΔt| < 1) for Δt < 2/λ and amplified beyond (eq. 5.2).
+Real relativeAmplification(Real dtOverLimit, DragScheme drag)
+{
+	const Real ms = 2.0, mw = 0.5, Q = 40.0, lambda = Q * (1 / mw + 1 / ms), dt = dtOverLimit * 2 / lambda;
+	OneNode    n(ms, mw, Q, Vec3::Zero(), Vec3(1, 0, 0), Vec3::Zero(), Vec3::Zero());
+	Real       w = 1;
+	for (int i = 0; i < 50; ++i) {
+		n.step(dt, drag);
+		n.fields.solidVelocity[0] = n.fields.solidVelocityNew[0];
+		n.fields.waterVelocity[0] = n.fields.waterVelocityNew[0];
+		n.fields.solid[0].momentum = ms * n.fields.solidVelocity[0];
+		n.fields.water[0].momentum = mw * n.fields.waterVelocity[0];
+	}
+	w = (n.fields.waterVelocity[0] - n.fields.solidVelocity[0]).norm();
+	return w;
+}
+
+TEST(ExplicitDrag, StableBelowTwoOverLambdaUnstableAbove)
+{
+	EXPECT_LT(relativeAmplification(0.95, DragScheme::Explicit), 1.0);
+	EXPECT_GT(relativeAmplification(1.05, DragScheme::Explicit), 1.0);
+	// the semi-implicit drag decays at any step
+	EXPECT_LT(relativeAmplification(100.0, DragScheme::SemiImplicit), 1e-6);
+}
+
+TEST(Walls, HeldSolidComponentReSolvesTheWaterWithDragToIt)
+{
+	GridGeometry       g = GridGeometry::forDomain(Vec3::Zero(), Vec3::Ones(), 1.0);
+	BoundaryConditions bcs;
+	bcs.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Free };
+	ConstrainedNodes c = ConstrainedNodes::build(g, bcs);
+	GridFields       fields;
+	fields.resize(g.nodeCount());
+	const std::size_t I = g.index(1, 1, 1); // on the base wall
+	const Real        Q = 7, mw = 0.5, dt = 1e-2;
+	fields.solid[I]     = SolidNode { 2.0, 2.0 * vs0, fs, 1, 0.6, Q };
+	fields.water[I]     = WaterNode { mw, mw * vw0, Vec3::Zero(), fw, Vec3::Zero() };
+	fields.solidVelocity[I] = vs0;
+	fields.waterVelocity[I] = vw0;
+	stages::integrateNodalMomentum(fields, c, dt, DragScheme::SemiImplicit, 1e-12, 1e-12);
+	EXPECT_TRUE(fields.solidVelocityNew[I].isZero());
+	const Vec3 expected = (mw / dt * vw0 + fw) / (mw / dt + Q); // water dragged against a held skeleton
+	EXPECT_LT((fields.waterVelocityNew[I] - expected).norm(), 1e-14);
+}
+
+} // namespace
