@@ -302,20 +302,28 @@ namespace stages {
 	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& P, std::vector<Real>& values, std::vector<Real>& cellSum,
 	                      std::vector<Real>& cellVolume)
 	{
-		const std::size_t count = P.size();
-		cellSum.assign(grid.nodeCount(), 0);
-		cellVolume.assign(grid.nodeCount(), 0);
-		std::vector<std::size_t> cellOf(count);
-		const Real               invH = 1 / grid.cellSize;
-		for (std::size_t p = 0; p < count; ++p) { // serial: one add per point, deterministic
-			const Vec3        u = (P.position[p] - grid.origin) * invH;
-			const std::size_t c = grid.index(static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])), static_cast<int>(std::floor(u[2])));
-			cellOf[p]           = c;
-			cellSum[c] += P.volume[p] * values[p];
-			cellVolume[c] += P.volume[p];
+		const std::size_t count = P.size(), cells = grid.nodeCount();
+		cellSum.assign(cells, 0);
+		cellVolume.assign(cells, 0);
+		const Real invH     = 1 / grid.cellSize;
+		auto       cellOf   = [&](std::size_t p) {
+                        const Vec3 u = (P.position[p] - grid.origin) * invH;
+                        return grid.index(static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])), static_cast<int>(std::floor(u[2])));
+		};
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			const std::size_t c = cellOf(p);
+			const Real        v = P.volume[p];
+#pragma omp atomic
+			cellSum[c] += v * values[p];
+#pragma omp atomic
+			cellVolume[c] += v;
 		}
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t p = 0; p < count; ++p) values[p] = cellSum[cellOf[p]] / cellVolume[cellOf[p]];
+		for (std::size_t p = 0; p < count; ++p) {
+			const std::size_t c = cellOf(p);
+			values[p]           = cellSum[c] / cellVolume[c];
+		}
 	}
 
 	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, SolidSet& set, Real dt)
@@ -387,13 +395,16 @@ namespace stages {
 
 	template <class Kernel> long firstPointOutsideGrid(const GridGeometry& grid, const MaterialPointSet& P)
 	{
-		for (std::size_t p = 0; p < P.size(); ++p) {
+		const std::size_t count = P.size();
+		long              first = static_cast<long>(count);
+#pragma omp parallel for schedule(static) reduction(min : first) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
 			for (int d = 0; d < 3; ++d)
-				if (w[d].first < 0 || w[d].first + Kernel::stencil > grid.nodes[d]) return static_cast<long>(p);
+				if (!std::isfinite(P.position[p][d]) || w[d].first < 0 || w[d].first + Kernel::stencil > grid.nodes[d]) first = std::min(first, static_cast<long>(p));
 		}
-		return -1;
+		return first == static_cast<long>(count) ? -1 : first;
 	}
 
 #define MPM_INSTANTIATE_STAGES(K)                                                                                                          \
