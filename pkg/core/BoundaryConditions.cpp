@@ -22,12 +22,13 @@ NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& 
 	return c;
 }
 
-void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, Real waterMassTolerance, GridFields& fields)
+void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, Real waterMassTolerance,
+                             GridFields& fields)
 {
 	const Real h = grid.cellSize;
 	for (int face = 0; face < faceCount; ++face) {
 		const WallConditions& wall = bcs.walls[face];
-		if (wall.water != WaterWall::Drained || wall.drainedPressure == 0) continue;
+		if (wall.water != WaterWall::Drained || (wall.drainedPressure == 0 && wall.waterTable == -std::numeric_limits<Real>::infinity())) continue;
 		const int  axis = face / 2, a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
 		const bool upperFace = face % 2 == 1;
 		const int  plane     = upperFace ? grid.upperWallNode[axis] : grid.wallNode[axis];
@@ -35,6 +36,9 @@ void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions&
 		inward[axis]         = upperFace ? -1 : 1;
 		// ∫ N dA over the face: h per in-plane axis inside the box, h/2 on its edges
 		auto share = [&](int d, int i) { return i < grid.wallNode[d] || i > grid.upperWallNode[d] ? 0.0 : (i == grid.wallNode[d] || i == grid.upperWallNode[d] ? h / 2 : h); };
+		// centroid of N on the face, where a linearly varying p̄ gives ∫ p̄ N dA = p̄(centroid) ∫ N dA:
+		// the node itself inside, h/3 inwards on an edge (the tent is one-sided there)
+		auto centroidShift = [&](int d, int i) { return i == grid.wallNode[d] ? h / 3 : (i == grid.upperWallNode[d] ? -h / 3 : 0.0); };
 		for (int j = 0; j < grid.nodes[a1]; ++j)
 			for (int k = 0; k < grid.nodes[a2]; ++k) {
 				const Real area = share(a1, j) * share(a2, k);
@@ -45,14 +49,17 @@ void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions&
 				idx[a2]   = k;
 				const std::size_t I = grid.index(idx[0], idx[1], idx[2]);
 				if (!(fields.water[I].mass > waterMassTolerance)) continue;
-				const Vec3 traction = wall.drainedPressure * area * inward;
+				Vec3 centroid = grid.nodePosition(idx[0], idx[1], idx[2]);
+				centroid[a1] += centroidShift(a1, j);
+				centroid[a2] += centroidShift(a2, k);
+				const Vec3 traction = wall.drainedPressureAt(centroid, gravity, waterDensity) * area * inward;
 				fields.water[I].porousForce += fields.porosity[I] * traction;
 				fields.water[I].pressureForce += traction;
 			}
 	}
 }
 
-void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, WaterPointSet& points)
+void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, WaterPointSet& points)
 {
 	const Vec3        lower = grid.lower(), upper = grid.upper();
 	const Real        tolerance = 1e-9 * grid.cellSize;
@@ -66,7 +73,7 @@ void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, 
 		for (std::size_t p = 0; p < count; ++p) {
 			const Real x = points.position[p][axis], l = points.halfLength[p][axis];
 			const bool reaches = upperFace ? x + l >= upper[axis] - tolerance : x - l <= lower[axis] + tolerance;
-			if (reaches) points.porePressure[p] = wall.drainedPressure;
+			if (reaches) points.porePressure[p] = wall.drainedPressureAt(points.position[p], gravity, waterDensity);
 		}
 	}
 }

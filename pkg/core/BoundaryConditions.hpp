@@ -5,7 +5,10 @@
 
 #include "Grid.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
 
 namespace mpm {
 
@@ -25,7 +28,19 @@ enum class WaterWall {
 struct WallConditions {
 	SolidWall solid           = SolidWall::Free;
 	WaterWall water           = WaterWall::Free;
-	Real      drainedPressure = 0; // p̄ [Pa] on a Drained face
+	Real      drainedPressure = 0; // uniform part of p̄ on a Drained face [Pa]
+	// Elevation of a free water surface [m] adding the hydrostatic part ρw |g| max(0, waterTable − z)
+	// to p̄ (z: elevation against gravity); the default −∞ adds nothing.
+	Real waterTable = -std::numeric_limits<Real>::infinity();
+
+	// p̄ at position x (theory.md eq. 2.1)
+	Real drainedPressureAt(const Vec3& x, const Vec3& gravity, Real waterDensity) const
+	{
+		const Real g = gravity.norm();
+		if (g == 0 || waterTable == -std::numeric_limits<Real>::infinity()) return drainedPressure;
+		const Real elevation = -gravity.dot(x) / g;
+		return drainedPressure + waterDensity * g * std::max<Real>(0, waterTable - elevation);
+	}
 };
 
 // One entry per Face (XMin, XMax, YMin, YMax, ZMin, ZMax).
@@ -47,9 +62,10 @@ struct WaterPointSet;
 struct GridFields;
 // The boundary terms of a Drained face with p̄ ≠ 0 (theory.md eq. 2.2): −∮ N n p̄ n̂ dA on the
 // water and −∮ N p̄ n̂ dA on the mixture, at the wall-plane nodes that carry water.
-void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, Real waterMassTolerance, GridFields& fields);
+void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, Real waterMassTolerance,
+                             GridFields& fields);
 
 // Hold the pore pressure of water points at Drained faces (theory.md §2, eq. 2.1).
-void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, WaterPointSet& points);
+void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, WaterPointSet& points);
 
 } // namespace mpm

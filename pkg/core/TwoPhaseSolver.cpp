@@ -163,7 +163,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	{
 		StageTimer t(stageSeconds_, Stage::MapWaterToGrid);
 		mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_);
-		addDrainedFaceTractions(grid_, domain_.boundaries, waterMassTolerance_, fields_);
+		addDrainedFaceTractions(grid_, domain_.boundaries, g, water_.density, waterMassTolerance_, fields_);
 	}
 	{
 		StageTimer t(stageSeconds_, Stage::IntegrateNodalMomentum);
@@ -220,7 +220,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 				averageOverCells(grid_, *w, waterDivergence_, cellSum_, cellVolume_);
 			}
 			updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
-			applyDrainedFaces(grid_, domain_.boundaries, *w);
+			applyDrainedFaces(grid_, domain_.boundaries, settings_.gravity, water_.density, *w);
 		}
 	}
 	if (settings_.shapeFunction == ShapeFunction::CpGimp) {

@@ -63,7 +63,7 @@ const AttrTable<MpmSoilMat>& MpmSoilMat::attributes()
 		realAttr("intrinsicPermeability", &M::intrinsicPermeability,
 		         "Intrinsic permeability κ [m²], > 0; the hydraulic conductivity is k = κ ρw |g| / μw [m s⁻¹] with the engine's gravity"),
 		boolAttr("kozenyCarman", &M::kozenyCarman,
-		         "Let the permeability follow the porosity, κ(n) = κ [n³/(1−n)²]/[n0³/(1−n0)²] with n0 = porosity (theory.md eq. 1.7) [-]"),
+		         "Let the permeability follow the porosity, κ(n) = κ · (n³/(1−n)²) / (n0³/(1−n0)²) with n0 = porosity (theory.md eq. 1.7) [-]"),
 	};
 	return table;
 }

@@ -59,6 +59,9 @@ mpm::Domain MpmTwoPhaseEngine::domain() const
 		wall.solid           = parseOption("solidWalls[" + std::string(faceNames[f]) + "]", solidWalls[f], solidWallOptions);
 		wall.water           = parseOption("waterWalls[" + std::string(faceNames[f]) + "]", waterWalls[f], waterWallOptions);
 		wall.drainedPressure = drainedPressure[f];
+		wall.waterTable      = drainedWaterTable[f];
+		if (!(wall.waterTable < std::numeric_limits<yade::Real>::infinity()))
+			mpm::throwOutOfRange("drainedWaterTable[" + std::string(faceNames[f]) + "]", wall.waterTable, "m", "[-inf (none), inf)");
 		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + std::string(faceNames[f]) + "]", wall.drainedPressure, "Pa", "finite values");
 	}
 	for (int a = 0; a < 3; ++a)
@@ -150,7 +153,9 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		boolAttr("cellAveraging", &E::cellAveraging, "Cell-averaged volumetric rates for the pore pressure and the skeleton (suppresses the pressure checkerboard) [-]"),
 		fixedListAttr("solidWalls", &E::solidWalls, 6, "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0) or 'fixed'"),
 		fixedListAttr("waterWalls", &E::waterWalls, 6, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
-		fixedListAttr("drainedPressure", &E::drainedPressure, 6, "Pore pressure p̄ held on each 'drained' face [Pa]"),
+		fixedListAttr("drainedPressure", &E::drainedPressure, 6, "Uniform part of the pore pressure p̄ held on each 'drained' face [Pa]"),
+		fixedListAttr("drainedWaterTable", &E::drainedWaterTable, 6,
+		              "Per 'drained' face, the elevation of a free water surface [m] adding the hydrostatic part ρw |g| max(0, table − z) to p̄ (z measured against gravity); -inf: none"),
 		readOnly(intAttr("stepsDone", &E::stepsDone, "Number of times the engine ran [-]")),
 		readOnly(realAttr("mpmTime", &E::mpmTime, "Total time the MPM state was advanced [s]")),
 		readOnly(intAttr("lastIter", &E::lastIter, "O.iter seen by the last run of the engine [-]")),
@@ -186,6 +191,7 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& BOOST_SERIALIZATION_NVP(solidWalls);
 	ar& BOOST_SERIALIZATION_NVP(waterWalls);
 	ar& BOOST_SERIALIZATION_NVP(drainedPressure);
+	ar& BOOST_SERIALIZATION_NVP(drainedWaterTable);
 	ar& BOOST_SERIALIZATION_NVP(stepsDone);
 	ar& BOOST_SERIALIZATION_NVP(mpmTime);
 	ar& BOOST_SERIALIZATION_NVP(lastIter);

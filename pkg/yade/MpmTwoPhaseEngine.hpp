@@ -8,6 +8,7 @@
 
 #include "../core/TwoPhaseSolver.hpp"
 
+#include <limits>
 #include <memory>
 
 namespace yade_mpm {
@@ -27,6 +28,7 @@ public:
 	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed
 	std::vector<std::string> waterWalls { 6, "free" };      // free | impermeable | drained
 	std::vector<yade::Real>  drainedPressure = std::vector<yade::Real>(6, 0.0); // p̄ per face [Pa]
+	std::vector<yade::Real>  drainedWaterTable = std::vector<yade::Real>(6, -std::numeric_limits<yade::Real>::infinity()); // [m], -inf: none
 
 	// outputs (read-only from Python)
 	long       stepsDone       = 0; // number of times action() ran [-]

@@ -167,4 +167,46 @@ TEST(UpwardSeepage, AboveCriticalGradientEffectiveStressTurnsTensile)
 	EXPECT_GT(s.maxSigma, 0.02 * s.buoyantWeight); // heave condition: the elastic skeleton is pulled apart
 }
 
+// Drained faces with a hydrostatic profile (theory.md eqs. 2.1–2.2): a geostatic column whose four
+// sides and top are drained to a water table at its top stays at rest with p = γw (H − z); the
+// profile enters both the reset of the face points and the face tractions.
+TEST(DrainedFaces, HydrostaticWaterTableOnTheSidesKeepsTheColumnAtRest)
+{
+	const double g = 9.81, H = 0.5, h = 0.05;
+	Column       c(H, h, 1e-4, g);
+	const double gammaW = c.water.density * g, gammaBuoyant = (c.rhoSat() - c.water.density) * g;
+	const double k0 = c.soil.poissonRatio / (1 - c.soil.poissonRatio);
+	for (std::size_t p = 0; p < c.solid.size(); ++p) {
+		const double depth      = H - c.solid.position[p].z();
+		c.fluid.porePressure[p] = gammaW * depth;
+		const double sz         = -gammaBuoyant * depth;
+		c.solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
+	}
+	for (int f = 0; f < 4; ++f) {
+		c.domain.boundaries.walls[f]            = { SolidWall::Slip, WaterWall::Drained };
+		c.domain.boundaries.walls[f].waterTable = H;
+	}
+	c.domain.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Drained };
+	c.start();
+	for (int i = 0; i < (getenv("MPM_PROFILE") ? 6 : 2); ++i) {
+		c.run(0.05);
+		double v = 0;
+		for (std::size_t p = 0; p < c.fluid.size(); ++p) v = std::max({ v, c.fluid.velocity[p].norm(), c.solid.velocity[p].norm() });
+		if (getenv("MPM_PROFILE")) std::printf("  t+%.2f s: max speed %.2e\n", 0.05 * (i + 1), v);
+	}
+	double pErr = 0, vmax = 0;
+	for (std::size_t p = 0; p < c.fluid.size(); ++p) {
+		pErr = std::max(pErr, std::abs(c.fluid.porePressure[p] - gammaW * (H - c.fluid.position[p].z())) / (gammaW * H));
+		vmax = std::max({ vmax, c.fluid.velocity[p].norm(), c.solid.velocity[p].norm() });
+	}
+	std::printf("water table on the sides: max p error %.4f of γw H, max speed %.2e m/s\n", pErr, vmax);
+	EXPECT_LT(pErr, h / (4 * H) + 1e-9); // the top layer is held at 0, h/4 below the surface
+	// Without the face tractions the water leaves sideways at Darcy speed (k/n = 2.5e-4 m/s here);
+	// with tractions evaluated at the node (not at the centroid of N) the edge imbalance drove
+	// 7e-4 m/s. What remains (measured 8e-5 m/s, about 0.3 k/n) comes from the points treating p
+	// as constant over their domains at the one-sided face edges; it is asserted below k/n.
+	const double darcySpeedAtUnitGradient = 1e-4 / c.soil.porosity;
+	EXPECT_LT(vmax, 0.5 * darcySpeedAtUnitGradient);
+}
+
 } // namespace
