@@ -5,6 +5,7 @@
 //
 // Usage: mpm_bench CELLS_PER_SIDE STEPS REPEATS
 #include "core/TwoPhaseSolver.hpp"
+#include "support/Fixtures.hpp"
 
 #include <omp.h>
 
@@ -49,35 +50,11 @@ int main(int argc, char** argv)
 	WaterParameters water;
 	water.bulkModulus          = 2.2e8;
 	soil.intrinsicPermeability = 1e-11;
-	const int     ppc = 2, perSide = cells * ppc;
-	const std::size_t n = static_cast<std::size_t>(perSide) * perSide * perSide;
-	const double  spacing = h / ppc, V = spacing * spacing * spacing;
-	SolidPointSet solid;
-	WaterPointSet fluid;
-	solid.resize(n);
-	fluid.resize(n);
-	const double rhoSat = (1 - soil.porosity) * soil.density + soil.porosity * water.density;
-	std::size_t  p      = 0;
-	for (int k = 0; k < perSide; ++k)
-		for (int j = 0; j < perSide; ++j)
-			for (int i = 0; i < perSide; ++i, ++p) {
-				const Vec3 x = spacing * Vec3(i + 0.5, j + 0.5, k + 0.5);
-				for (MaterialPointSet* set : { static_cast<MaterialPointSet*>(&solid), static_cast<MaterialPointSet*>(&fluid) }) {
-					set->position[p]   = x;
-					set->volume[p]     = V;
-					set->halfLength[p] = Vec3::Constant(spacing / 2);
-				}
-				solid.mass[p]              = (1 - soil.porosity) * soil.density * V;
-				solid.initialVolume[p]     = V;
-				solid.initialHalfLength[p] = solid.halfLength[p];
-				solid.porosity[p]          = soil.porosity;
-				fluid.mass[p]              = soil.porosity * water.density * V;
-				fluid.porosity[p]          = soil.porosity;
-				const double depth         = side - x.z();
-				fluid.porePressure[p]      = water.density * g * depth;
-				const double sz            = -(rhoSat - water.density) * g * depth;
-				solid.effectiveStress[p] << 0.5 * sz, 0.5 * sz, sz, 0, 0, 0;
-			}
+	const auto    lattice = fixtures::lattice(Vec3::Zero(), Vec3::Constant(side), h, 2);
+	SolidPointSet solid   = fixtures::solidLattice(lattice, soil.porosity, soil.density);
+	WaterPointSet fluid   = fixtures::waterLattice(lattice, soil.porosity, water.density);
+	fixtures::setGeostatic(solid, fluid, soil, water, g, side);
+	const std::size_t n = solid.size();
 	Domain d;
 	d.upper    = Vec3::Constant(side);
 	d.cellSize = h;

@@ -11,41 +11,65 @@ using mpm::WaterPointSet;
 MpmSolidPoints::~MpmSolidPoints() = default;
 MpmWaterPoints::~MpmWaterPoints() = default;
 
+namespace {
+	// The entries every point set has (mpm::MaterialPointSet); `pos` first: it defines the count.
+	template <class Owner, class Set> AttrTable<Owner> commonPointAttributes(Set Owner::*points, const char* phase)
+	{
+		static const std::string posDoc  = std::string("Positions of the ") + phase + " points, shape (N, 3) [m]. Assigning it sets the number of points N.";
+		static const std::string velDoc  = std::string("Velocities of the ") + phase + " points, shape (N, 3) [m s⁻¹]";
+		return {
+			pointArrayAttr("pos", points, &mpm::MaterialPointSet::position, posDoc.c_str(), true),
+			pointArrayAttr("vel", points, &mpm::MaterialPointSet::velocity, velDoc.c_str()),
+			pointArrayAttr("volume", points, &mpm::MaterialPointSet::volume, "Current mixture volume represented by each point, shape (N,) [m³]"),
+			pointArrayAttr("halfLength", points, &mpm::MaterialPointSet::halfLength, "GIMP half-lengths of each point's domain l_p, shape (N, 3) [m]"),
+			readOnly(AttrSpec<Owner> { "count", "Number of points N [-]", [points](const Owner& o) { return py::object((o.*points).size()); }, nullptr }),
+		};
+	}
+
+	template <class Archive> void serializeCommon(Archive& ar, mpm::MaterialPointSet& points)
+	{
+		serializeFlat(ar, "position", points.position);
+		serializeFlat(ar, "velocity", points.velocity);
+		serializeFlat(ar, "mass", points.mass);
+		serializeFlat(ar, "volume", points.volume);
+		serializeFlat(ar, "halfLength", points.halfLength);
+	}
+} // namespace
+
 const AttrTable<MpmSolidPoints>& MpmSolidPoints::attributes()
 {
 	using S = MpmSolidPoints;
-	static const AttrTable<S> table {
-		pointArrayAttr(
-		        "pos", &S::points, &SolidPointSet::position, "Positions of the solid points, shape (N, 3) [m]. Assigning it sets the number of points N.", true),
-		pointArrayAttr("vel", &S::points, &SolidPointSet::velocity, "Velocities of the solid points v_s, shape (N, 3) [m s⁻¹]"),
-		pointArrayAttr("mass", &S::points, &SolidPointSet::mass, "Solid mass of each point m_sp = (1−n0) ρs V0, shape (N,) [kg]"),
-		pointArrayAttr("volume", &S::points, &SolidPointSet::volume, "Current mixture volume of each point V_sp, shape (N,) [m³]"),
-		pointArrayAttr("initialVolume", &S::points, &SolidPointSet::initialVolume, "Initial mixture volume of each point V0, shape (N,) [m³]"),
-		pointArrayAttr("halfLength", &S::points, &SolidPointSet::halfLength, "GIMP half-lengths of each point's domain l_p, shape (N, 3) [m]"),
-		pointArrayAttr("initialHalfLength", &S::points, &SolidPointSet::initialHalfLength, "Initial GIMP half-lengths l0_p, shape (N, 3) [m]"),
-		pointArrayAttr("defGrad", &S::points, &SolidPointSet::deformationGradient, "Deformation gradient F of each point, shape (N, 3, 3) [-]"),
-		pointArrayAttr("stress", &S::points, &SolidPointSet::effectiveStress, "Effective stress σ′ (tension-positive), symmetric, shape (N, 3, 3) [Pa]"),
-		pointArrayAttr("porosity", &S::points, &SolidPointSet::porosity, "Porosity n of the mixture at each solid point, shape (N,) [-]"),
-		pointArrayAttr("extForce", &S::points, &SolidPointSet::externalForce, "Prescribed load on each point, e.g. a surface traction times the point's face area, shape (N, 3) [N]"),
-		readOnly(AttrSpec<S> { "count", "Number of points N [-]", [](const S& s) { return py::object(s.points.size()); }, nullptr }),
-	};
+	static const AttrTable<S> table = [] {
+		AttrTable<S> t = commonPointAttributes(&S::points, "solid");
+		for (auto&& spec : AttrTable<S> {
+		             pointArrayAttr("mass", &S::points, &SolidPointSet::mass, "Solid mass of each point m_sp = (1−n0) ρs V0, shape (N,) [kg]"),
+		             pointArrayAttr("initialVolume", &S::points, &SolidPointSet::initialVolume, "Initial mixture volume of each point V0, shape (N,) [m³]"),
+		             pointArrayAttr("initialHalfLength", &S::points, &SolidPointSet::initialHalfLength, "Initial GIMP half-lengths l0_p, shape (N, 3) [m]"),
+		             pointArrayAttr("defGrad", &S::points, &SolidPointSet::deformationGradient, "Deformation gradient F of each point, shape (N, 3, 3) [-]"),
+		             pointArrayAttr("stress", &S::points, &SolidPointSet::effectiveStress, "Effective stress σ′ (tension-positive), symmetric, shape (N, 3, 3) [Pa]"),
+		             pointArrayAttr("porosity", &S::points, &SolidPointSet::porosity, "Porosity n of the mixture at each solid point, shape (N,) [-]"),
+		             pointArrayAttr("extForce", &S::points, &SolidPointSet::externalForce,
+		                            "Prescribed load on each point, e.g. a surface traction times the point's face area, shape (N, 3) [N]"),
+		     })
+			t.push_back(std::move(spec));
+		return t;
+	}();
 	return table;
 }
 
 const AttrTable<MpmWaterPoints>& MpmWaterPoints::attributes()
 {
 	using W = MpmWaterPoints;
-	static const AttrTable<W> table {
-		pointArrayAttr(
-		        "pos", &W::points, &WaterPointSet::position, "Positions of the water points, shape (N, 3) [m]. Assigning it sets the number of points N.", true),
-		pointArrayAttr("vel", &W::points, &WaterPointSet::velocity, "Velocities of the water points v_w, shape (N, 3) [m s⁻¹]"),
-		pointArrayAttr("mass", &W::points, &WaterPointSet::mass, "Water mass of each point m_wp = n0 ρw V0, shape (N,) [kg]"),
-		pointArrayAttr("volume", &W::points, &WaterPointSet::volume, "Current mixture volume attached to each point V_wp, shape (N,) [m³]"),
-		pointArrayAttr("halfLength", &W::points, &WaterPointSet::halfLength, "GIMP half-lengths of each point's domain l_p, shape (N, 3) [m]"),
-		pointArrayAttr("porePressure", &W::points, &WaterPointSet::porePressure, "Pore-water pressure p (compression-positive), shape (N,) [Pa]"),
-		pointArrayAttr("porosity", &W::points, &WaterPointSet::porosity, "Porosity n interpolated at each water point (1 for free water), shape (N,) [-]"),
-		readOnly(AttrSpec<W> { "count", "Number of points N [-]", [](const W& s) { return py::object(s.points.size()); }, nullptr }),
-	};
+	static const AttrTable<W> table = [] {
+		AttrTable<W> t = commonPointAttributes(&W::points, "water");
+		for (auto&& spec : AttrTable<W> {
+		             pointArrayAttr("mass", &W::points, &WaterPointSet::mass, "Water mass of each point m_wp = n0 ρw V0, shape (N,) [kg]"),
+		             pointArrayAttr("porePressure", &W::points, &WaterPointSet::porePressure, "Pore-water pressure p (compression-positive), shape (N,) [Pa]"),
+		             pointArrayAttr("porosity", &W::points, &WaterPointSet::porosity, "Porosity n interpolated at each water point (1 for free water), shape (N,) [-]"),
+		     })
+			t.push_back(std::move(spec));
+		return t;
+	}();
 	return table;
 }
 
@@ -64,11 +88,7 @@ void MpmWaterPoints::pyRegisterClass(py::object scope)
 template <class Archive> void MpmSolidPoints::serialize(Archive& ar, unsigned int)
 {
 	ar& boost::serialization::make_nvp("Shape", boost::serialization::base_object<yade::Shape>(*this));
-	serializeFlat(ar, "position", points.position);
-	serializeFlat(ar, "velocity", points.velocity);
-	serializeFlat(ar, "mass", points.mass);
-	serializeFlat(ar, "volume", points.volume);
-	serializeFlat(ar, "halfLength", points.halfLength);
+	serializeCommon(ar, points);
 	serializeFlat(ar, "initialVolume", points.initialVolume);
 	serializeFlat(ar, "initialHalfLength", points.initialHalfLength);
 	serializeFlat(ar, "deformationGradient", points.deformationGradient);
@@ -80,11 +100,7 @@ template <class Archive> void MpmSolidPoints::serialize(Archive& ar, unsigned in
 template <class Archive> void MpmWaterPoints::serialize(Archive& ar, unsigned int)
 {
 	ar& boost::serialization::make_nvp("Shape", boost::serialization::base_object<yade::Shape>(*this));
-	serializeFlat(ar, "position", points.position);
-	serializeFlat(ar, "velocity", points.velocity);
-	serializeFlat(ar, "mass", points.mass);
-	serializeFlat(ar, "volume", points.volume);
-	serializeFlat(ar, "halfLength", points.halfLength);
+	serializeCommon(ar, points);
 	serializeFlat(ar, "porePressure", points.porePressure);
 	serializeFlat(ar, "porosity", points.porosity);
 }

@@ -28,14 +28,7 @@ struct Column {
 		const auto l = fixtures::lattice(Vec3::Zero(), Vec3(h, h, H), h, 2);
 		solid        = fixtures::solidLattice(l, soil.porosity, soil.density);
 		fluid        = fixtures::waterLattice(l, soil.porosity, water.density);
-		const double rhoSat = (1 - soil.porosity) * soil.density + soil.porosity * water.density;
-		const double k0     = soil.poissonRatio / (1 - soil.poissonRatio);
-		for (std::size_t p = 0; p < solid.size(); ++p) {
-			const double depth    = H - solid.position[p].z();
-			fluid.porePressure[p] = water.density * g * depth;
-			const double sz       = -(rhoSat - water.density) * g * depth;
-			solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
-		}
+		fixtures::setGeostatic(solid, fluid, soil, water, g, H);
 		Domain d;
 		d.upper    = Vec3(h, h, H);
 		d.cellSize = h;

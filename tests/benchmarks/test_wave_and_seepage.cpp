@@ -109,13 +109,7 @@ Seepage seep(double gradientOverCritical)
 	Column       c(H, h, k, g);
 	const double gammaW = c.water.density * g, gammaBuoyant = (c.rhoSat() - c.water.density) * g;
 	const double iCritical = gammaBuoyant / gammaW, i = gradientOverCritical * iCritical, dh = i * H;
-	const double k0 = c.soil.poissonRatio / (1 - c.soil.poissonRatio);
-	for (std::size_t p = 0; p < c.solid.size(); ++p) {
-		const double depth    = H - c.solid.position[p].z();
-		c.fluid.porePressure[p] = gammaW * depth;
-		const double sz       = -gammaBuoyant * depth;
-		c.solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
-	}
+	fixtures::setGeostatic(c.solid, c.fluid, c.soil, c.water, g, H);
 	c.domain.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Drained, gammaW * (H + dh) };
 	c.domain.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Drained, 0.0 };
 	c.start();
@@ -174,14 +168,8 @@ TEST(DrainedFaces, HydrostaticWaterTableOnTheSidesKeepsTheColumnAtRest)
 {
 	const double g = 9.81, H = 0.5, h = 0.05;
 	Column       c(H, h, 1e-4, g);
-	const double gammaW = c.water.density * g, gammaBuoyant = (c.rhoSat() - c.water.density) * g;
-	const double k0 = c.soil.poissonRatio / (1 - c.soil.poissonRatio);
-	for (std::size_t p = 0; p < c.solid.size(); ++p) {
-		const double depth      = H - c.solid.position[p].z();
-		c.fluid.porePressure[p] = gammaW * depth;
-		const double sz         = -gammaBuoyant * depth;
-		c.solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
-	}
+	const double gammaW = c.water.density * g;
+	fixtures::setGeostatic(c.solid, c.fluid, c.soil, c.water, g, H);
 	for (int f = 0; f < 4; ++f) {
 		c.domain.boundaries.walls[f]            = { SolidWall::Slip, WaterWall::Drained };
 		c.domain.boundaries.walls[f].waterTable = H;

@@ -1,6 +1,7 @@
 // Builders shared by the core tests: lattices of solid and water points in a box.
 #pragma once
 
+#include "core/Parameters.hpp"
 #include "core/PointSets.hpp"
 
 namespace mpm::fixtures {
@@ -52,6 +53,20 @@ inline WaterPointSet waterLattice(const Lattice& l, Real porosity, Real waterDen
 		w.porosity[p]   = porosity;
 	}
 	return w;
+}
+
+// The geostatic state below a free surface at elevation `top` (gravity g along −z): hydrostatic pore
+// pressure ρw g d and the effective stress of the buoyant weight, σ′_zz = −(ρsat − ρw) g d,
+// σ′_xx = σ′_yy = K0 σ′_zz with K0 = ν/(1 − ν) (uniaxial strain).
+inline void setGeostatic(SolidPointSet& solid, WaterPointSet& fluid, const SoilParameters& soil, const WaterParameters& water, Real g, Real top)
+{
+	const Real rhoSat = (1 - soil.porosity) * soil.density + soil.porosity * water.density;
+	const Real k0     = soil.poissonRatio / (1 - soil.poissonRatio);
+	for (std::size_t p = 0; p < solid.size(); ++p) {
+		const Real sz = -(rhoSat - water.density) * g * (top - solid.position[p].z());
+		solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
+	}
+	for (std::size_t p = 0; p < fluid.size(); ++p) fluid.porePressure[p] = water.density * g * (top - fluid.position[p].z());
 }
 
 } // namespace mpm::fixtures
