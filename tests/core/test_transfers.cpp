@@ -168,3 +168,23 @@ TEST(PatchTest, UniformStressGivesZeroInteriorForceAndUniformStrainUniformStress
 }
 
 } // namespace
+
+namespace {
+
+// cpGIMP (theory.md eq. 3.3): domains follow the stretch along each axis, within [0.01 h, h/2].
+TEST(CpGimp, DomainsFollowTheStretchWithinBounds)
+{
+	SolidPointSet s;
+	s.resize(3);
+	const Real h = 0.1;
+	for (auto& l0 : s.initialHalfLength) l0 = Vec3::Constant(h / 4);
+	s.deformationGradient[0] = Vec3(1.2, 0.9, 1.0).asDiagonal();
+	s.deformationGradient[1] = Vec3(3.0, 0.01, 1.0).asDiagonal(); // beyond both bounds
+	s.deformationGradient[2] << 1.1, 0.3, 0, 0, 1, 0, 0, 0, -0.8;  // shear and inversion: |F_ii|
+	stages::updateDomainsCpGimp(s, h);
+	EXPECT_LT((s.halfLength[0] - Vec3(0.03, 0.0225, 0.025)).norm(), 1e-15);
+	EXPECT_LT((s.halfLength[1] - Vec3(h / 2, 0.01 * h, 0.025)).norm(), 1e-15);
+	EXPECT_LT((s.halfLength[2] - Vec3(0.0275, 0.025, 0.02)).norm(), 1e-15);
+}
+
+} // namespace
