@@ -1,0 +1,184 @@
+// Element tests of the Drucker–Prager skeleton (theory.md §7), driven by strain increments through
+// the elastic trial + return mapping; every reference value is derived here from the model.
+#include "core/Errors.hpp"
+#include "core/Plasticity.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+namespace {
+
+using namespace mpm;
+
+constexpr Real E = 20e6, nu = 0.3, K = E / (3 * (1 - 2 * nu)), G = E / (2 * (1 + nu));
+constexpr Real degree = M_PI / 180;
+
+Mat3 elasticTrial(const Mat3& s, const Mat3& de) { return s + (K - 2 * G / 3) * de.trace() * Mat3::Identity() + 2 * G * de; }
+
+struct Point {
+	Mat3 stress;
+	Real kappa = 0;
+	void strain(const Mat3& de, const StrengthParameters& p)
+	{
+		const ReturnResult r = returnDruckerPrager(elasticTrial(stress, de), K, G, p, kappa);
+		stress               = r.stress;
+		kappa += r.plasticShearStrain;
+	}
+};
+
+Real meanP(const Mat3& s) { return -s.trace() / 3; }
+Real tauOf(const Mat3& s)
+{
+	const Mat3 d = s - s.trace() / 3 * Mat3::Identity();
+	return std::sqrt(0.5 * d.squaredNorm());
+}
+
+// One strain step with axial compression dε_zz, lateral strain found so that σ_xx stays at
+// `lateral` (bisection), and ε_yy either equal to ε_xx (triaxial) or held at 0 (plane strain).
+void stressControlledStep(Point& pt, Real dez, Real lateral, bool planeStrain, const StrengthParameters& p)
+{
+	Real lo = -1e-2, hi = 1e-2;
+	for (int i = 0; i < 80; ++i) {
+		const Real mid = 0.5 * (lo + hi);
+		Point      t   = pt;
+		t.strain(Vec3(mid, planeStrain ? 0 : mid, dez).asDiagonal(), p);
+		(t.stress(0, 0) > lateral ? hi : lo) = mid; // more lateral extension → more tensile σ_xx
+	}
+	pt.strain(Vec3(0.5 * (lo + hi), planeStrain ? 0 : 0.5 * (lo + hi), dez).asDiagonal(), p);
+}
+
+TEST(DruckerPrager, ReturnLandsOnTheConeRadiallyWithTheDilatancyOfThePotential)
+{
+	StrengthParameters p;
+	p.frictionAngle  = 35 * degree;
+	p.dilatancyAngle = 8 * degree;
+	p.cohesion       = 2e3;
+	const auto cone  = DruckerPragerCone::planeStrainMatch(p.frictionAngle, p.dilatancyAngle);
+	std::mt19937_64 rng(3);
+	std::normal_distribution<Real> n(0, 40e3);
+	int yielded = 0;
+	for (int i = 0; i < 500; ++i) {
+		Mat3 a;
+		for (int k = 0; k < 9; ++k) a.data()[k] = n(rng);
+		const Mat3 trial = 0.5 * (a + a.transpose()) - 60e3 * Mat3::Identity();
+		const auto r     = returnDruckerPrager(trial, K, G, p, 0);
+		const Real f     = tauOf(r.stress) - cone.eta * meanP(r.stress) - cone.xi * p.cohesion;
+		EXPECT_LE(f, 1e-6 * 60e3);
+		if (!r.yielded) {
+			EXPECT_EQ(r.stress, trial);
+			continue;
+		}
+		++yielded;
+		if (tauOf(r.stress) == 0) continue; // apex
+		EXPECT_NEAR(f, 0, 1e-6 * 60e3);
+		// radial: the deviator keeps its direction
+		const Mat3 sT = trial + meanP(trial) * Mat3::Identity(), sN = r.stress + meanP(r.stress) * Mat3::Identity();
+		EXPECT_LT((sT / sT.norm() - sN / sN.norm()).norm(), 1e-10);
+		// flow along g = τ − η̄ P: Δε_v^p = η̄ Δγ (dilation) and Δγ = Δτ/G
+		const Real dGamma = (tauOf(trial) - tauOf(r.stress)) / G;
+		EXPECT_NEAR(r.plasticShearStrain, dGamma, 1e-12);
+		EXPECT_NEAR((meanP(r.stress) - meanP(trial)) / K, cone.etaBar * dGamma, 1e-12);
+	}
+	EXPECT_GT(yielded, 50);
+}
+
+TEST(DruckerPrager, ElasticUnloadingFromTheYieldSurface)
+{
+	StrengthParameters p;
+	Point              pt { -50e3 * Mat3::Identity() };
+	for (int i = 0; i < 400; ++i) stressControlledStep(pt, -2e-5, -50e3, false, p);
+	const Mat3 before = pt.stress;
+	const Real kappa  = pt.kappa;
+	ASSERT_GT(kappa, 0); // it yielded
+	const Mat3 de = Vec3(-1e-5, -1e-5, 2e-5).asDiagonal(); // unload the deviator
+	pt.strain(de, p);
+	EXPECT_LT((pt.stress - elasticTrial(before, de)).norm(), 1e-9 * before.norm());
+	EXPECT_EQ(pt.kappa, kappa);
+}
+
+TEST(DruckerPrager, TriaxialCompressionPeakOfTheCone)
+{
+	// σ3 = −P0 held, compress axially: on the path P = P0 + q/3, τ = q/√3, so the cone
+	// τ = ηP + ξc is reached at q = (η P0 + ξ c)/(1/√3 − η/3).
+	for (Real phi : { 30.0, 38.0 }) {
+		StrengthParameters p;
+		p.frictionAngle            = phi * degree;
+		p.residualFrictionAngle    = p.frictionAngle;
+		p.cohesion                 = 1e3;
+		const Real  P0             = 40e3;
+		const auto  cone           = DruckerPragerCone::planeStrainMatch(p.frictionAngle, 0);
+		const Real  expected       = (cone.eta * P0 + cone.xi * p.cohesion) / (1 / std::sqrt(3.0) - cone.eta / 3);
+		Point       pt { -P0 * Mat3::Identity() };
+		for (int i = 0; i < 1500; ++i) stressControlledStep(pt, -2e-5, -P0, false, p);
+		const Real q = pt.stress(0, 0) - pt.stress(2, 2);
+		EXPECT_NEAR(q, expected, 1e-6 * expected) << "φ = " << phi;
+		EXPECT_NEAR(pt.stress(0, 0), -P0, 1e-6 * P0);
+	}
+}
+
+TEST(DruckerPrager, PlaneStrainPeakIsMohrCoulombWithAssociatedFlow)
+{
+	// The plane-strain match of the cone reproduces Mohr–Coulomb in plane strain under associated
+	// flow: at the peak of a biaxial test, (σ1 − σ3)/(σ1 + σ3) = sin φ (compression-positive, c = 0).
+	for (Real phi : { 25.0, 35.0 }) {
+		StrengthParameters p;
+		p.frictionAngle         = phi * degree;
+		p.dilatancyAngle        = p.frictionAngle;
+		p.residualFrictionAngle = p.frictionAngle;
+		Point pt { -40e3 * Mat3::Identity() };
+		for (int i = 0; i < 3000; ++i) stressControlledStep(pt, -2e-5, -40e3, true, p);
+		const Real s1 = -pt.stress(2, 2), s3 = -pt.stress(0, 0);
+		EXPECT_NEAR((s1 - s3) / (s1 + s3), std::sin(p.frictionAngle), 2e-4) << "φ = " << phi;
+	}
+}
+
+TEST(DruckerPrager, SofteningReachesTheResidualStrength)
+{
+	StrengthParameters p;
+	p.frictionAngle         = 38 * degree;
+	p.residualFrictionAngle = 30 * degree;
+	p.softeningStrain       = 0.01;
+	const Real P0           = 40e3;
+	auto       peakFor      = [&](Real phi) {
+                const auto cone = DruckerPragerCone::planeStrainMatch(phi, 0);
+                return cone.eta * P0 / (1 / std::sqrt(3.0) - cone.eta / 3);
+	};
+	Point pt { -P0 * Mat3::Identity() };
+	Real  qMax = 0;
+	for (int i = 0; i < 6000; ++i) {
+		stressControlledStep(pt, -5e-5, -P0, false, p);
+		qMax = std::max(qMax, pt.stress(0, 0) - pt.stress(2, 2));
+	}
+	const Real q = pt.stress(0, 0) - pt.stress(2, 2);
+	EXPECT_GT(qMax, 0.97 * peakFor(p.frictionAngle)); // close to the peak before softening
+	EXPECT_NEAR(q, peakFor(p.residualFrictionAngle), 0.01 * q); // κ ≫ κ_s: residual
+	EXPECT_GT(pt.kappa, 10 * p.softeningStrain);
+}
+
+TEST(DruckerPrager, CohesionlessSandCarriesNoTension)
+{
+	StrengthParameters p; // c = 0, σ_t = 0
+	const auto         r = returnDruckerPrager(5e3 * Mat3::Identity() + Vec3(1e3, 0, -1e3).asDiagonal().toDenseMatrix(), K, G, p, 0);
+	EXPECT_TRUE(r.yielded);
+	EXPECT_LT(r.stress.norm(), 1e-9); // the apex: stress-free
+	p.tensionCutoff = 2e3;
+	p.cohesion      = 10e3;
+	const auto t    = returnDruckerPrager(8e3 * Mat3::Identity(), K, G, p, 0);
+	EXPECT_LT((t.stress - 2e3 * Mat3::Identity()).norm(), 1e-9); // isotropic tension limited to σ_t
+}
+
+TEST(StrengthParameters, RangesAreChecked)
+{
+	StrengthParameters p;
+	EXPECT_NO_THROW(p.validate());
+	p.dilatancyAngle = 40 * degree; // ψ > φ
+	EXPECT_THROW(p.validate(), InvalidParameter);
+	p                       = {};
+	p.residualFrictionAngle = 45 * degree;
+	EXPECT_THROW(p.validate(), InvalidParameter);
+}
+
+} // namespace
