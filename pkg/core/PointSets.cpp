@@ -75,6 +75,7 @@ void SolidPointSet::resize(std::size_t n)
 	effectiveStress.resize(n, Voigt6::Zero());
 	porosity.resize(n, 0);
 	externalForce.resize(n, Vec3::Zero());
+	plasticShearStrain.resize(n, 0);
 }
 
 void SolidPointSet::validate(const std::string& setName) const
@@ -87,8 +88,10 @@ void SolidPointSet::validate(const std::string& setName) const
 	requireSize(setName, "effectiveStress", effectiveStress, n);
 	requireSize(setName, "porosity", porosity, n);
 	requireSize(setName, "externalForce", externalForce, n);
+	requireSize(setName, "plasticShearStrain", plasticShearStrain, n);
 	requirePositive(setName, "initialVolume", initialVolume, "m³");
 	requireFinite(setName, "externalForce", externalForce);
+	requireFinite(setName, "plasticShearStrain", plasticShearStrain);
 	requireFinite(setName, "deformationGradient", deformationGradient);
 	requireFinite(setName, "effectiveStress", effectiveStress);
 	requirePorosity(setName, porosity, false);

@@ -34,6 +34,7 @@ struct SolidPointSet : MaterialPointSet {
 	std::vector<Voigt6> effectiveStress;     // σ′_p [Pa], tension-positive, Voigt order
 	std::vector<Real>   porosity;            // n_p [-]
 	std::vector<Vec3>   externalForce;       // prescribed point load, e.g. a surface traction × area [N]
+	std::vector<Real>   plasticShearStrain;  // κ [-], accumulated plastic shear strain (theory.md eq. 7.4)
 
 	void resize(std::size_t n);
 	void validate(const std::string& setName) const;

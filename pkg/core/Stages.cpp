@@ -330,7 +330,8 @@ namespace stages {
 	{
 		SolidPointSet&    P      = *set.points;
 		const Real        E      = set.soil.youngModulus, nu = set.soil.poissonRatio;
-		const Real        lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), shear = E / (2 * (1 + nu));
+		const Real        lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), shear = E / (2 * (1 + nu)), bulk = lambda + 2 * shear / 3;
+		const bool        plastic = set.model == SkeletonModel::DruckerPrager;
 		const std::size_t count  = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
@@ -346,7 +347,14 @@ namespace stages {
 			P.volume[p]   = F.determinant() * P.initialVolume[p]; // eq. 4.14
 			const Mat3 sigma = voigtToMatrix(P.effectiveStress[p]);
 			const Mat3 rate  = lambda * d.trace() * Mat3::Identity() + 2 * shear * d; // D^e : d
-			P.effectiveStress[p] = matrixToVoigt(sigma + dt * (spin * sigma - sigma * spin + rate)); // eq. 4.15 (Jaumann)
+			const Mat3 trial = sigma + dt * (spin * sigma - sigma * spin + rate);     // eq. 4.15 (Jaumann)
+			if (plastic) { // eqs. 7.3–7.5
+				const ReturnResult r = returnDruckerPrager(trial, bulk, shear, set.strength, P.plasticShearStrain[p]);
+				P.effectiveStress[p] = matrixToVoigt(r.stress);
+				P.plasticShearStrain[p] += r.plasticShearStrain;
+			} else {
+				P.effectiveStress[p] = matrixToVoigt(trial);
+			}
 			P.porosity[p]        = std::clamp<Real>(1 - (1 - P.porosity[p]) / dJ, 1e-5, 1 - 1e-5); // eq. 1.1
 		}
 	}

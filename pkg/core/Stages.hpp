@@ -6,6 +6,7 @@
 #include "BoundaryConditions.hpp"
 #include "Grid.hpp"
 #include "Parameters.hpp"
+#include "Plasticity.hpp"
 #include "PointSets.hpp"
 #include "ShapeFunctions.hpp"
 
@@ -20,9 +21,11 @@ enum class DragScheme {
 
 // A set of solid points and the parameters of its material.
 struct SolidSet {
-	SolidPointSet* points;
-	SoilParameters soil;
-	bool           kozenyCarman = false; // κ(n) by the Kozeny–Carman ratio (theory.md eq. 1.7)
+	SolidPointSet*     points;
+	SoilParameters     soil;
+	bool               kozenyCarman = false;                        // κ(n) by the Kozeny–Carman ratio (theory.md eq. 1.7)
+	SkeletonModel      model        = SkeletonModel::LinearElastic; // constitutive stage (theory.md §7)
+	StrengthParameters strength {};                                 // used by the plastic models
 };
 
 // Thread-private copies of the nodal arrays for race-free scatter (one per extra thread).
@@ -93,9 +96,9 @@ namespace stages {
 	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& points, std::vector<Real>& values, std::vector<Real>& cellSum,
 	                      std::vector<Real>& cellVolume);
 
-	// Step 9 (theory.md eqs. 4.14–4.15): deformation gradient, volume, Jaumann elastic effective-
-	// stress update and porosity from the velocity gradients; `volumetricRate` (one per point)
-	// replaces tr d when given (cell-averaged volumetric strain rate, B-bar).
+	// Step 9 (theory.md eqs. 4.14–4.15, §7): deformation gradient, volume, Jaumann elastic trial
+	// stress, return mapping of the set's skeleton model, porosity; `volumetricRate` (one per
+	// point) replaces tr d when given (cell-averaged volumetric strain rate, B-bar).
 	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, SolidSet& set, Real dt);
 
 	// Step 10 (theory.md eq. 4.16): pore-pressure rate ṗ = −(Kw/n)[(1−n)∇·v^s + n∇·v^w] at every

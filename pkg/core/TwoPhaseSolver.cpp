@@ -76,6 +76,7 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 	Real minSolid = inf, minWater = inf;
 	for (std::size_t s = 0; s < solids.size(); ++s) {
 		solids[s].soil.validate();
+		if (solids[s].model != SkeletonModel::LinearElastic) solids[s].strength.validate();
 		solids[s].points->validate("solid set " + std::to_string(s));
 		minSolid = smallestMass(*solids[s].points, minSolid);
 	}

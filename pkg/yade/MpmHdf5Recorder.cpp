@@ -66,7 +66,7 @@ void MpmHdf5Recorder::action()
 			const auto& P = s->points;
 			sets.push_back({ "solid_" + id,
 			                 { field("position", P.position), field("velocity", P.velocity), field("stress", P.effectiveStress), field("porosity", P.porosity),
-			                   field("volume", P.volume) } });
+			                   field("volume", P.volume), field("plasticShearStrain", P.plasticShearStrain) } });
 		} else if (auto* w = dynamic_cast<MpmWaterPoints*>(shape.get())) {
 			const auto& P = w->points;
 			sets.push_back({ "water_" + id,

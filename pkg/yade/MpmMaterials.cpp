@@ -21,6 +21,26 @@ mpm::SoilParameters MpmSoilMat::parameters() const
 	return p;
 }
 
+mpm::SkeletonModel MpmSoilMat::skeletonModel() const
+{
+	if (model == "linearElastic") return mpm::SkeletonModel::LinearElastic;
+	if (model == "DruckerPrager") return mpm::SkeletonModel::DruckerPrager;
+	throw mpm::InvalidParameter("model = '" + model + "' is not one of: linearElastic, DruckerPrager");
+}
+
+mpm::StrengthParameters MpmSoilMat::strength() const
+{
+	mpm::StrengthParameters p;
+	p.frictionAngle         = frictionAngle;
+	p.dilatancyAngle        = dilatancyAngle;
+	p.cohesion              = cohesion;
+	p.tensionCutoff         = tensionCutoff;
+	p.residualFrictionAngle = residualFrictionAngle;
+	p.softeningStrain       = softeningStrain;
+	if (skeletonModel() != mpm::SkeletonModel::LinearElastic) p.validate();
+	return p;
+}
+
 mpm::WaterParameters MpmWaterMat::parameters() const
 {
 	mpm::WaterParameters p;
@@ -37,6 +57,7 @@ void MpmSoilMat::callPostLoad()
 	yade::Material::callPostLoad();
 	try {
 		parameters();
+		strength();
 	} catch (const mpm::InvalidParameter& e) {
 		raisePython(PyExc_ValueError, "MpmSoilMat: " + std::string(e.what()));
 	}
@@ -62,6 +83,14 @@ const AttrTable<MpmSoilMat>& MpmSoilMat::attributes()
 		realAttr("porosity", &M::porosity, "Initial porosity n0 [-], in (0, 1)"),
 		realAttr("intrinsicPermeability", &M::intrinsicPermeability,
 		         "Intrinsic permeability κ [m²], > 0; the hydraulic conductivity is k = κ ρw |g| / μw [m s⁻¹] with the engine's gravity"),
+		stringAttr("model", &M::model, "Skeleton model [-]: 'linearElastic' or 'DruckerPrager' (non-associated cone matched to Mohr–Coulomb in plane strain)"),
+		realAttr("frictionAngle", &M::frictionAngle, "Peak friction angle φ [rad], 0 < φ < π/2"),
+		realAttr("dilatancyAngle", &M::dilatancyAngle, "Dilatancy angle ψ [rad], 0 ≤ ψ ≤ φ"),
+		realAttr("cohesion", &M::cohesion, "Cohesion c [Pa], ≥ 0"),
+		realAttr("tensionCutoff", &M::tensionCutoff, "Largest isotropic tension carried σ_t [Pa], ≥ 0 (the cone's apex limits it further)"),
+		realAttr("residualFrictionAngle", &M::residualFrictionAngle, "Residual friction angle φ_r reached by softening [rad], 0 < φ_r ≤ φ"),
+		realAttr("softeningStrain", &M::softeningStrain,
+		         "Softening scale κ_s of φ(κ) = φ_r + (φ − φ_r) exp(−κ/κ_s) with the accumulated plastic shear strain κ [-], ≥ 0; 0: no softening"),
 		boolAttr("kozenyCarman", &M::kozenyCarman,
 		         "Let the permeability follow the porosity, κ(n) = κ · (n³/(1−n)²) / (n0³/(1−n0)²) with n0 = porosity (theory.md eq. 1.7) [-]"),
 	};
@@ -99,6 +128,13 @@ template <class Archive> void MpmSoilMat::serialize(Archive& ar, unsigned int)
 	ar& BOOST_SERIALIZATION_NVP(porosity);
 	ar& BOOST_SERIALIZATION_NVP(intrinsicPermeability);
 	ar& BOOST_SERIALIZATION_NVP(kozenyCarman);
+	ar& BOOST_SERIALIZATION_NVP(model);
+	ar& BOOST_SERIALIZATION_NVP(frictionAngle);
+	ar& BOOST_SERIALIZATION_NVP(dilatancyAngle);
+	ar& BOOST_SERIALIZATION_NVP(cohesion);
+	ar& BOOST_SERIALIZATION_NVP(tensionCutoff);
+	ar& BOOST_SERIALIZATION_NVP(residualFrictionAngle);
+	ar& BOOST_SERIALIZATION_NVP(softeningStrain);
 }
 
 template <class Archive> void MpmWaterMat::serialize(Archive& ar, unsigned int)

@@ -7,6 +7,7 @@
 #include "YadeAbi.hpp"
 
 #include "../core/Parameters.hpp"
+#include "../core/Plasticity.hpp"
 
 namespace yade_mpm {
 
@@ -17,6 +18,13 @@ public:
 	yade::Real porosity              = mpm::SoilParameters {}.porosity;              // n0 [-]
 	yade::Real intrinsicPermeability = mpm::SoilParameters {}.intrinsicPermeability; // κ [m²]
 	bool       kozenyCarman          = false; // κ(n) by the Kozeny–Carman ratio
+	std::string model                 = "linearElastic"; // linearElastic | DruckerPrager
+	yade::Real frictionAngle          = mpm::StrengthParameters {}.frictionAngle;         // φ [rad]
+	yade::Real dilatancyAngle         = mpm::StrengthParameters {}.dilatancyAngle;        // ψ [rad]
+	yade::Real cohesion               = mpm::StrengthParameters {}.cohesion;              // c [Pa]
+	yade::Real tensionCutoff          = mpm::StrengthParameters {}.tensionCutoff;         // σ_t [Pa]
+	yade::Real residualFrictionAngle  = mpm::StrengthParameters {}.residualFrictionAngle; // φ_r [rad]
+	yade::Real softeningStrain        = mpm::StrengthParameters {}.softeningStrain;       // κ_s [-]
 
 	MpmSoilMat()
 	{
@@ -24,7 +32,9 @@ public:
 		createIndex();
 	}
 	~MpmSoilMat() override;
-	mpm::SoilParameters parameters() const; // validated core parameters
+	mpm::SoilParameters     parameters() const; // validated core parameters
+	mpm::SkeletonModel      skeletonModel() const;
+	mpm::StrengthParameters strength() const; // validated when the model is plastic
 	void                callPostLoad() override;
 	void                pyRegisterClass(boost::python::object scope) override;
 	template <class Archive> void serialize(Archive& ar, unsigned int version);

@@ -48,6 +48,8 @@ const AttrTable<MpmSolidPoints>& MpmSolidPoints::attributes()
 		             pointArrayAttr("defGrad", &S::points, &SolidPointSet::deformationGradient, "Deformation gradient F of each point, shape (N, 3, 3) [-]"),
 		             pointArrayAttr("stress", &S::points, &SolidPointSet::effectiveStress, "Effective stress σ′ (tension-positive), symmetric, shape (N, 3, 3) [Pa]"),
 		             pointArrayAttr("porosity", &S::points, &SolidPointSet::porosity, "Porosity n of the mixture at each solid point, shape (N,) [-]"),
+		             pointArrayAttr("plasticShearStrain", &S::points, &SolidPointSet::plasticShearStrain,
+		                            "Accumulated plastic shear strain κ of each point, shape (N,) [-]"),
 		             pointArrayAttr("extForce", &S::points, &SolidPointSet::externalForce,
 		                            "Prescribed load on each point, e.g. a surface traction times the point's face area, shape (N, 3) [N]"),
 		     })
@@ -95,6 +97,7 @@ template <class Archive> void MpmSolidPoints::serialize(Archive& ar, unsigned in
 	serializeFlat(ar, "effectiveStress", points.effectiveStress);
 	serializeFlat(ar, "porosity", points.porosity);
 	serializeFlat(ar, "externalForce", points.externalForce);
+	serializeFlat(ar, "plasticShearStrain", points.plasticShearStrain);
 }
 
 template <class Archive> void MpmWaterPoints::serialize(Archive& ar, unsigned int)

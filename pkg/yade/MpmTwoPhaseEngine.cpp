@@ -100,7 +100,7 @@ void MpmTwoPhaseEngine::action()
 			auto* mat = dynamic_cast<MpmSoilMat*>(yade::abi::materialOf(body.get()).get());
 			if (!mat) throw mpm::InvalidParameter(where + " carries MpmSolidPoints but its material is not an MpmSoilMat");
 			s->points.validate(where + ".shape");
-			solids.push_back(mpm::SolidSet { &s->points, mat->parameters(), mat->kozenyCarman });
+			solids.push_back(mpm::SolidSet { &s->points, mat->parameters(), mat->kozenyCarman, mat->skeletonModel(), mat->strength() });
 			solid += static_cast<long>(s->points.size());
 		} else if (auto* w = dynamic_cast<MpmWaterPoints*>(shape.get())) {
 			auto* mat = dynamic_cast<MpmWaterMat*>(yade::abi::materialOf(body.get()).get());

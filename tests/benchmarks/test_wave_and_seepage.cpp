@@ -39,10 +39,12 @@ struct Column {
 		domain.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
 		settings.gravity                                         = Vec3(0, 0, -g);
 	}
-	void start()
+	SkeletonModel      model = SkeletonModel::LinearElastic;
+	StrengthParameters strength;
+	void               start()
 	{
 		solver = std::make_unique<TwoPhaseSolver>(domain, settings);
-		solver->setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+		solver->setPoints({ SolidSet { &solid, soil, false, model, strength } }, { &fluid }, water);
 	}
 	double run(double duration)
 	{
@@ -101,12 +103,15 @@ struct Seepage {
 	double maxSigma;         // largest σ′zz outside the two drained point layers [Pa]
 	double maxSigmaBoundary; // largest σ′zz in the drained layers, where p is imposed [Pa]
 	double buoyantWeight;    // γ′ H [Pa]
+	double meanSolidVz;      // mean vertical solid velocity inside [m s⁻¹]
+	double meanSigmaZ;       // mean σ′zz inside [Pa]
 };
 
-Seepage seep(double gradientOverCritical)
+Seepage seep(double gradientOverCritical, SkeletonModel model = SkeletonModel::LinearElastic)
 {
 	const double g = 9.81, H = 1.0, h = 0.05, k = 1e-2;
 	Column       c(H, h, k, g);
+	c.model = model;
 	const double gammaW = c.water.density * g, gammaBuoyant = (c.rhoSat() - c.water.density) * g;
 	const double iCritical = gammaBuoyant / gammaW, i = gradientOverCritical * iCritical, dh = i * H;
 	fixtures::setGeostatic(c.solid, c.fluid, c.soil, c.water, g, H);
@@ -116,7 +121,7 @@ Seepage seep(double gradientOverCritical)
 	const double cv = analytical::consolidationCoefficient(c.soil.intrinsicPermeability / c.water.viscosity, c.soil.constrainedModulus(),
 	                                                       c.soil.porosity, c.water.bulkModulus);
 	c.run(2.5 * H * H / cv); // Tv = 2.5: within 0.1% of the steady state
-	Seepage out { 0, 0, -1e300, -1e300, gammaBuoyant * H };
+	Seepage out { 0, 0, -1e300, -1e300, gammaBuoyant * H, 0, 0 };
 	const double layer = h / 2; // point spacing: the drained layers are the outermost point layers
 	double  flux = 0;
 	int     count = 0;
@@ -129,9 +134,13 @@ Seepage seep(double gradientOverCritical)
 		const double expected = -(gammaBuoyant - i * gammaW) * depth;
 		out.sigmaError        = std::max(out.sigmaError, std::abs(c.solid.effectiveStress[p][2] - expected) / (gammaBuoyant * H));
 		flux += c.soil.porosity * (c.fluid.velocity[p].z() - c.solid.velocity[p].z());
+		out.meanSolidVz += c.solid.velocity[p].z();
+		out.meanSigmaZ += c.solid.effectiveStress[p][2];
 		++count;
 	}
 	out.fluxError = std::abs(flux / count / (k * i) - 1);
+	out.meanSolidVz /= count;
+	out.meanSigmaZ /= count;
 	if (getenv("MPM_PROFILE"))
 		for (std::size_t p = 0; p < c.solid.size(); p += 8)
 			std::printf("  z %.3f p %.1f (steady %.1f) szz %.1f (steady %.1f) vw %.3e vs %.3e\n", c.fluid.position[p].z(), c.fluid.porePressure[p],
@@ -159,6 +168,27 @@ TEST(UpwardSeepage, AboveCriticalGradientEffectiveStressTurnsTensile)
 	EXPECT_LT(s.fluxError, 0.02);
 	EXPECT_LT(s.sigmaError, 0.02);
 	EXPECT_GT(s.maxSigma, 0.02 * s.buoyantWeight); // heave condition: the elastic skeleton is pulled apart
+}
+
+// Quicksand with a cohesionless Drucker–Prager sand (no tension): below the critical gradient the
+// column stands as in the elastic case; above it the effective stress vanishes (the stress returns
+// to the apex) and the seepage force lifts the column: the heave of a quick condition.
+TEST(Quicksand, StandsBelowAndLiftsAboveTheCriticalGradient)
+{
+	const Seepage below = seep(0.8, SkeletonModel::DruckerPrager);
+	EXPECT_LT(below.sigmaError, 0.02);
+	EXPECT_LT(below.maxSigma, 0);
+	EXPECT_LT(std::abs(below.meanSolidVz), 1e-4);
+	const Seepage above = seep(1.2, SkeletonModel::DruckerPrager);
+	std::printf("quicksand: mean σ′zz %.1f Pa below, %.2f Pa above; mean solid v_z %.2e m/s below, %.2e m/s above\n", below.meanSigmaZ,
+	            above.meanSigmaZ, below.meanSolidVz, above.meanSolidVz);
+	EXPECT_LT(above.maxSigma, 1e-6 * above.buoyantWeight); // never tensile
+	// the geostatic mean effective stress is −γ′H/2; above i_c it collapses (measured 7% of it,
+	// the column accelerating against its drag as it rises), below i_c it is the steady
+	// −(γ′ − iγw)H/2 = −0.1 γ′H
+	EXPECT_GT(above.meanSigmaZ, -0.1 * 0.5 * above.buoyantWeight);
+	EXPECT_NEAR(below.meanSigmaZ, -0.1 * below.buoyantWeight, 0.01 * below.buoyantWeight);
+	EXPECT_GT(above.meanSolidVz, 1e-2); // the column lifts (rising at 8.5 cm/s after 0.18 s)
 }
 
 // Drained faces with a hydrostatic profile (theory.md eqs. 2.1–2.2): a geostatic column whose four

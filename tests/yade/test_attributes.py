@@ -9,7 +9,7 @@ import yade.wrapper as w
 
 CLASSES = [w.MpmTwoPhaseEngine, w.MpmSolidPoints, w.MpmWaterPoints, w.MpmSoilMat, w.MpmWaterMat, w.MpmHdf5Recorder]
 # The one notation for units (doc/conventions.md); "-" marks a dimensionless quantity.
-ALLOWED_UNITS = {"m", "s", "kg", "N", "Pa", "Pa s", "m²", "m³", "m s⁻¹", "m s⁻²", "kg m⁻³", "-"}
+ALLOWED_UNITS = {"m", "s", "kg", "N", "rad", "Pa", "Pa s", "m²", "m³", "m s⁻¹", "m s⁻²", "kg m⁻³", "-"}
 
 
 def own_properties(cls):
