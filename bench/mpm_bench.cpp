@@ -3,7 +3,9 @@
 // soil points, threads, soil point-steps per second, per second per thread, bytes per soil point,
 // and the share of each stage. A soil point is one solid point with its water point.
 //
-// Usage: mpm_bench CELLS_PER_SIDE STEPS REPEATS
+// Usage: mpm_bench CELLS_PER_SIDE STEPS REPEATS [dry]
+// With `dry` the block has solid points only (single-phase): the soil-point column then counts
+// solid points.
 #include "core/TwoPhaseSolver.hpp"
 #include "support/Fixtures.hpp"
 
@@ -38,10 +40,11 @@ long residentKiB()
 
 int main(int argc, char** argv)
 {
-	if (argc != 4) {
-		std::fprintf(stderr, "usage: %s CELLS_PER_SIDE STEPS REPEATS\n", argv[0]);
+	if (argc < 4 || argc > 5 || (argc == 5 && std::string(argv[4]) != "dry")) {
+		std::fprintf(stderr, "usage: %s CELLS_PER_SIDE STEPS REPEATS [dry]\n", argv[0]);
 		return 2;
 	}
+	const bool dry = argc == 5;
 	const int    cells = std::atoi(argv[1]), steps = std::atoi(argv[2]), repeats = std::atoi(argv[3]);
 	const double h = 0.01, side = cells * h, g = 9.81;
 	const long   rssBefore = residentKiB();
@@ -64,7 +67,11 @@ int main(int argc, char** argv)
 	SolverSettings s;
 	s.gravity = Vec3(0, 0, -g);
 	TwoPhaseSolver solver(d, s);
-	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	if (dry) {
+		fluid = WaterPointSet {};
+		for (auto& st : solid.effectiveStress) st *= (1 - soil.porosity) * soil.density / ((1 - soil.porosity) * soil.density + soil.porosity * water.density - water.density); // dry geostatic
+	}
+	solver.setPoints({ SolidSet { &solid, soil } }, dry ? std::vector<WaterPointSet*> {} : std::vector<WaterPointSet*> { &fluid }, water);
 	const double dt = 0.5 * solver.timeStepLimits().critical;
 	solver.step(dt); // warm-up: allocates the scratch arrays
 	const long rssAfter = residentKiB();
@@ -83,7 +90,7 @@ int main(int argc, char** argv)
 	auto         after   = solver.stageSeconds();
 	double       total   = 0;
 	for (int i = 0; i < static_cast<int>(Stage::Count); ++i) total += after[i] - before[i];
-	std::printf("%zu\t%d\t%.4g\t%.4g\t%.0f", n, threads, median, median / threads, 1024.0 * (rssAfter - rssBefore) / n);
+	std::printf("%s%zu\t%d\t%.4g\t%.4g\t%.0f", dry ? "dry " : "", n, threads, median, median / threads, 1024.0 * (rssAfter - rssBefore) / n);
 	for (int i = 0; i < static_cast<int>(Stage::Count); ++i) std::printf("\t%s=%.1f", stageName(static_cast<Stage>(i)), 100 * (after[i] - before[i]) / total);
 	std::printf("\n");
 	return 0;

@@ -89,20 +89,23 @@ ConstrainedNodes ConstrainedNodes::build(const GridGeometry& grid, const Boundar
 
 namespace stages {
 
-	void resetGrid(GridFields& fields)
+	void resetGrid(GridFields& fields, bool water)
 	{
 		std::fill(fields.solid.begin(), fields.solid.end(), zeroOf(SolidNode {}));
+		if (!water) return;
 		std::fill(fields.water.begin(), fields.water.end(), zeroOf(WaterNode {}));
+		std::fill(fields.waterVelocity.begin(), fields.waterVelocity.end(), Vec3::Zero());
+		std::fill(fields.waterVelocityNew.begin(), fields.waterVelocityNew.end(), Vec3::Zero());
 	}
 
 	template <class Kernel>
-	void mapSolidToGrid(const GridGeometry& grid, const std::vector<SolidSet>& sets, const WaterParameters& water, const Vec3& gravity,
+	void mapSolidToGrid(const GridGeometry& grid, const std::vector<SolidSet>& sets, const WaterParameters* water, const Vec3& gravity,
 	                    GridFields& fields, ScatterWorkspace& workspace)
 	{
 		for (const SolidSet& set : sets) {
 			const SolidPointSet& P         = *set.points;
 			const Real           invGrain  = 1 / set.soil.density;
-			const Real           dragScale = water.viscosity / set.soil.intrinsicPermeability; // μw/κ0
+			const Real           dragScale = water ? water->viscosity / set.soil.intrinsicPermeability : 0; // μw/κ0; no drag when dry
 			const Real           n0        = set.soil.porosity;
 			const bool           kc        = set.kozenyCarman;
 			scatter(fields.solid, workspace.solid, P.size(), [&](std::size_t p, SolidNode* nodes) {
@@ -416,7 +419,7 @@ namespace stages {
 	}
 
 #define MPM_INSTANTIATE_STAGES(K)                                                                                                          \
-	template void mapSolidToGrid<K>(const GridGeometry&, const std::vector<SolidSet>&, const WaterParameters&, const Vec3&, GridFields&,   \
+	template void mapSolidToGrid<K>(const GridGeometry&, const std::vector<SolidSet>&, const WaterParameters*, const Vec3&, GridFields&,   \
 	                                ScatterWorkspace&);                                                                                    \
 	template void mapWaterToGrid<K>(const GridGeometry&, std::vector<WaterPointSet*>&, const Vec3&, GridFields&, ScatterWorkspace&);       \
 	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, MaterialPointSet&,    \

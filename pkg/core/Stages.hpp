@@ -44,13 +44,13 @@ struct ConstrainedNodes {
 
 namespace stages {
 
-	// Step 0: zero every nodal array.
-	void resetGrid(GridFields& fields);
+	// Step 0: zero the nodal arrays (the water ones only when `water`: a dry scene leaves them zero).
+	void resetGrid(GridFields& fields, bool water = true);
 
 	// Step 2 (theory.md eqs. 4.1–4.3): solid mass, momentum, effective-stress force, weight,
-	// point loads, mixture and grain volumes, drag coefficient.
+	// point loads, mixture and grain volumes, drag coefficient (none without water: `water` null).
 	template <class Kernel>
-	void mapSolidToGrid(const GridGeometry& grid, const std::vector<SolidSet>& sets, const WaterParameters& water, const Vec3& gravity,
+	void mapSolidToGrid(const GridGeometry& grid, const std::vector<SolidSet>& sets, const WaterParameters* water, const Vec3& gravity,
 	                    GridFields& fields, ScatterWorkspace& workspace);
 
 	// Nodal porosity n_I = 1 − Σ S m/ρs / Σ S V (theory.md eq. 4.4); 1 where there is no solid.

@@ -151,17 +151,19 @@ void TwoPhaseSolver::step(Real dt)
 template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 {
 	using namespace stages;
-	const Vec3& g = settings_.gravity;
+	const Vec3& g   = settings_.gravity;
+	const bool  wet = !waters_.empty(); // a dry scene skips every water stage and the drag
 	{
 		StageTimer t(stageSeconds_, Stage::ResetGrid);
-		resetGrid(fields_);
+		resetGrid(fields_, wet || !waterFieldsZero_);
+		waterFieldsZero_ = !wet;
 	}
 	{
 		StageTimer t(stageSeconds_, Stage::MapSolidToGrid);
-		mapSolidToGrid<Kernel>(grid_, solids_, water_, g, fields_, workspace_);
-		computeNodalPorosity(fields_);
+		mapSolidToGrid<Kernel>(grid_, solids_, wet ? &water_ : nullptr, g, fields_, workspace_);
+		if (wet) computeNodalPorosity(fields_);
 	}
-	{
+	if (wet) {
 		StageTimer t(stageSeconds_, Stage::MapWaterToGrid);
 		mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_);
 		addDrainedFaceTractions(grid_, domain_.boundaries, g, water_.density, waterMassTolerance_, fields_);
@@ -197,7 +199,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 		for (const SolidSet& s : solids_) solidSets.push_back(s.points);
 		for (const WaterPointSet* w : waters_) waterSets.push_back(w);
 		remapVelocities<Kernel>(grid_, solidSets, fields_.solid, solidMassTolerance_, constrained_, true, fields_.solidVelocityNew, workspace_.momentum);
-		remapVelocities<Kernel>(grid_, waterSets, fields_.water, waterMassTolerance_, constrained_, false, fields_.waterVelocityNew, workspace_.momentum);
+		if (wet) remapVelocities<Kernel>(grid_, waterSets, fields_.water, waterMassTolerance_, constrained_, false, fields_.waterVelocityNew, workspace_.momentum);
 	}
 	const bool average = settings_.cellAveragedVolumetricRate;
 	{

@@ -88,6 +88,7 @@ private:
 	Real                          solidMassTolerance_ = 0;
 	Real                          waterMassTolerance_ = 0;
 	long                          steps_              = 0;
+	bool                          waterFieldsZero_    = false; // the water nodal arrays hold zeros (dry steps skip them)
 	std::array<double, static_cast<int>(Stage::Count)> stageSeconds_ {};
 };
 

@@ -12,6 +12,8 @@ namespace {
 
 using namespace mpm;
 
+const WaterParameters water0 {};
+
 struct Box {
 	GridGeometry grid = GridGeometry::forDomain(Vec3(0, 0, 0), Vec3(0.4, 0.3, 0.5), 0.1);
 	GridFields   fields;
@@ -53,7 +55,7 @@ TEST(ParticleToGrid, ConservesMassAndMomentumOfEachPhase)
 	std::vector<SolidSet>       solids { SolidSet { &solid, soil } };
 	std::vector<WaterPointSet*> waters { &water };
 	stages::resetGrid(box.fields);
-	stages::mapSolidToGrid<GimpKernel>(box.grid, solids, WaterParameters {}, Vec3::Zero(), box.fields, ws);
+	stages::mapSolidToGrid<GimpKernel>(box.grid, solids, &water0, Vec3::Zero(), box.fields, ws);
 	stages::computeNodalPorosity(box.fields);
 	stages::mapWaterToGrid<GimpKernel>(box.grid, waters, Vec3::Zero(), box.fields, ws);
 	Real mS = 0, mW = 0, gS = 0, gW = 0;
@@ -82,7 +84,7 @@ TEST(ParticleToGrid, DragCoefficientFollowsDarcyAndKozenyCarman)
 		std::vector<SolidSet> sets { SolidSet { &solid, soil, kc } };
 		ScatterWorkspace      ws;
 		stages::resetGrid(box.fields);
-		stages::mapSolidToGrid<GimpKernel>(box.grid, sets, water, Vec3::Zero(), box.fields, ws);
+		stages::mapSolidToGrid<GimpKernel>(box.grid, sets, &water, Vec3::Zero(), box.fields, ws);
 		Real expected = 0, total = 0;
 		const Real n0 = soil.porosity;
 		for (std::size_t p = 0; p < solid.size(); ++p) {
@@ -137,7 +139,7 @@ TEST(PatchTest, UniformStressGivesZeroInteriorForceAndUniformStrainUniformStress
 	std::vector<SolidSet> solids { SolidSet { &s, soil } };
 	ScatterWorkspace      ws;
 	stages::resetGrid(box.fields);
-	stages::mapSolidToGrid<GimpKernel>(box.grid, solids, WaterParameters {}, Vec3::Zero(), box.fields, ws);
+	stages::mapSolidToGrid<GimpKernel>(box.grid, solids, &water0, Vec3::Zero(), box.fields, ws);
 	int interior = 0;
 	for (int k = 2; k < box.grid.nodes[2] - 2; ++k)
 		for (int j = 2; j < box.grid.nodes[1] - 2; ++j)

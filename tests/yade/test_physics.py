@@ -91,3 +91,29 @@ def test_points_leaving_the_grid_stop_the_run_with_a_clear_message():
     with pytest.raises(RuntimeError, match=r"at step \d+: (solid|water) set 0, point \d+ at \(.*\) m is outside the grid"):
         O.run(100, True)
     assert np.isfinite(solid.pos).all() and np.isfinite(fluid.porePressure).all()
+
+
+def test_dry_column_without_water_points_stays_at_rest():
+    """Dry mode: solid points only (no MpmWaterPoints body). The single-phase column starts in its
+    dry geostatic state σ′_zz = −(1 − n) ρs g d and stays at rest on its fixed base."""
+    height, cell = 0.5, 0.05
+    soil = w.MpmSoilMat(density=2650, youngModulus=20e6, poissonRatio=0.3, porosity=0.4)
+    water = w.MpmWaterMat()
+    O.materials.append([soil, water])
+    solid_body, _ = yade_mpm.saturated_block((0, 0, 0), (cell, cell, height), cell, soil, water, geostatic=False)
+    solid = solid_body.shape
+    dry_weight = 0.6 * 2650 * 9.81
+    stress = np.zeros((solid.count, 3, 3))
+    stress[:, 2, 2] = -dry_weight * (height - solid.pos[:, 2])
+    stress[:, 0, 0] = stress[:, 1, 1] = 0.3 / 0.7 * stress[:, 2, 2]
+    solid.stress = stress
+    O.bodies.append(solid_body)
+    engine = w.MpmTwoPhaseEngine(label="mpm", gravity=G, domainMin=(0, 0, 0), domainMax=(cell, cell, height), cellSize=cell,
+                                 solidWalls=("slip",) * 4 + ("fixed", "free"))
+    O.engines = [engine]
+    O.dt = 1e-3
+    O.run(20, True)
+    assert engine.waterPointCount == 0 and engine.solidPointCount == solid.count
+    assert np.linalg.norm(solid.vel, axis=1).max() < 1e-5
+    error = np.abs(solid.stress[:, 2, 2] + dry_weight * (height - solid.pos[:, 2])).max() / (dry_weight * height)
+    assert error < 0.01
