@@ -2,6 +2,8 @@
 
 #include "Errors.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 #include <limits>
 
@@ -53,6 +55,67 @@ ReturnResult returnDruckerPrager(const Mat3& trial, Real K, Real G, const Streng
 	}
 	// apex (eq. 7.5): no deviator is carried; the whole shear is plastic
 	return { -Papex * Mat3::Identity(), tau / G, true };
+}
+
+namespace {
+	using Vec3r = Vec3;
+	// √(2 e:e) of the deviatoric part of a principal plastic strain increment: the same measure
+	// of plastic shear as Δγ of the Drucker–Prager return (theory.md eq. 7.4)
+	Real plasticShear(const Vec3r& de)
+	{
+		const Vec3r e = de - Vec3r::Constant(de.sum() / 3);
+		return std::sqrt(2 * e.squaredNorm());
+	}
+} // namespace
+
+ReturnResult returnMohrCoulomb(const Mat3& trial, Real K, Real G, const StrengthParameters& strength, Real kappa)
+{
+	// principal values, compression-positive and ordered σ1 ≥ σ2 ≥ σ3
+	Eigen::SelfAdjointEigenSolver<Mat3> eig(trial);
+	const Vec3r tensionAscending = eig.eigenvalues(); // λ0 ≤ λ1 ≤ λ2 (tension-positive)
+	const Vec3r st(-tensionAscending[0], -tensionAscending[1], -tensionAscending[2]);
+	const Real  phi = strength.frictionAngleAt(kappa), psi = std::min(strength.dilatancyAngle, phi);
+	const Real  sp = std::sin(phi), sq = std::sin(psi), c = strength.cohesion;
+	const Real  apex = std::min(c / std::tan(phi), strength.tensionCutoff); // largest isotropic tension carried (as in eq. 7.3)
+	auto f = [&](const Vec3r& s, int major, int minor) { return (s[major] - s[minor]) - (s[major] + s[minor]) * sp - 2 * c * std::cos(phi); };
+	auto rebuild = [&](const Vec3r& s) { // back to tension-positive, trial directions
+		const Vec3r t(-s[0], -s[1], -s[2]);
+		return Mat3(eig.eigenvectors() * t.asDiagonal() * eig.eigenvectors().transpose());
+	};
+	if (f(st, 0, 2) <= 0 && (st.array() >= -apex - 1e-12 * (1 + st.cwiseAbs().maxCoeff())).all()) return { trial, 0, false };
+	const Real lambda = K - 2 * G / 3;
+	Mat3       D      = lambda * Mat3::Ones() + 2 * G * Mat3::Identity(); // principal elasticity
+	// gradients of f and g for the pair (major, minor)
+	auto grad = [](int major, int minor, Real sinAngle) {
+		Vec3r v = Vec3r::Zero();
+		v[major] = 1 - sinAngle;
+		v[minor] = -(1 + sinAngle);
+		return v;
+	};
+	// plane return (eq. 7.6)
+	{
+		const Vec3r a = grad(0, 2, sp), b = grad(0, 2, sq);
+		const Real  dl = f(st, 0, 2) / a.dot(D * b);
+		const Vec3r s  = st - dl * (D * b);
+		if (dl >= 0 && s[0] >= s[1] - 1e-12 * std::abs(s[1]) && s[1] >= s[2] - 1e-12 * std::abs(s[1]) && (s.array() >= -apex).all())
+			return { rebuild(s), plasticShear(dl * b), true };
+	}
+	// edge returns (eq. 7.7): triaxial compression σ1 = σ2 (pairs (0,2),(1,2)) or extension σ2 = σ3 (pairs (0,2),(0,1))
+	for (int edge = 0; edge < 2; ++edge) {
+		const int   m2 = edge == 0 ? 1 : 0, n2 = edge == 0 ? 2 : 1;
+		const Vec3r a1 = grad(0, 2, sp), b1 = grad(0, 2, sq), a2 = grad(m2, n2, sp), b2 = grad(m2, n2, sq);
+		Eigen::Matrix2d A;
+		A << a1.dot(D * b1), a1.dot(D * b2), a2.dot(D * b1), a2.dot(D * b2);
+		const Eigen::Vector2d dl = A.partialPivLu().solve(Eigen::Vector2d(f(st, 0, 2), f(st, m2, n2)));
+		const Vec3r           s  = st - dl[0] * (D * b1) - dl[1] * (D * b2);
+		const bool ordered = s[0] >= s[1] - 1e-9 * (1 + std::abs(s[1])) && s[1] >= s[2] - 1e-9 * (1 + std::abs(s[1]));
+		if (dl[0] >= 0 && dl[1] >= 0 && ordered && (s.array() >= -apex).all())
+			return { rebuild(s), plasticShear(dl[0] * b1 + dl[1] * b2), true };
+	}
+	// apex (eq. 7.8): isotropic tension −apex (stress-free for a cohesionless sand)
+	const Vec3r s = Vec3r::Constant(-apex);
+	const Vec3r de = D.inverse() * (st - s); // the whole difference is plastic
+	return { rebuild(s), plasticShear(de), true };
 }
 
 } // namespace mpm

@@ -10,6 +10,7 @@ namespace mpm {
 enum class SkeletonModel {
 	LinearElastic,
 	DruckerPrager, // non-associated cone matched to Mohr–Coulomb in plane strain (theory.md eq. 7.2)
+	MohrCoulomb,   // non-associated Mohr–Coulomb in principal stresses (theory.md eqs. 7.6–7.8)
 };
 
 // Strength parameters of a sand (angles in radians). Ranges are checked by validate().
@@ -39,5 +40,9 @@ struct ReturnResult {
 
 // Return a trial stress (tension-positive) onto the Drucker–Prager cone (theory.md eqs. 7.3–7.5).
 ReturnResult returnDruckerPrager(const Mat3& trial, Real bulkModulus, Real shearModulus, const StrengthParameters& strength, Real plasticShearStrain);
+
+// Return a trial stress onto the Mohr–Coulomb surface in principal stresses (plane, edge or apex;
+// theory.md eqs. 7.6–7.8), rotating back with the trial's principal directions.
+ReturnResult returnMohrCoulomb(const Mat3& trial, Real bulkModulus, Real shearModulus, const StrengthParameters& strength, Real plasticShearStrain);
 
 } // namespace mpm

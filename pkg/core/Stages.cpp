@@ -334,7 +334,7 @@ namespace stages {
 		SolidPointSet&    P      = *set.points;
 		const Real        E      = set.soil.youngModulus, nu = set.soil.poissonRatio;
 		const Real        lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), shear = E / (2 * (1 + nu)), bulk = lambda + 2 * shear / 3;
-		const bool        plastic = set.model == SkeletonModel::DruckerPrager;
+		const bool        plastic = set.model != SkeletonModel::LinearElastic, mohrCoulomb = set.model == SkeletonModel::MohrCoulomb;
 		const std::size_t count  = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
@@ -352,7 +352,8 @@ namespace stages {
 			const Mat3 rate  = lambda * d.trace() * Mat3::Identity() + 2 * shear * d; // D^e : d
 			const Mat3 trial = sigma + dt * (spin * sigma - sigma * spin + rate);     // eq. 4.15 (Jaumann)
 			if (plastic) { // eqs. 7.3–7.5
-				const ReturnResult r = returnDruckerPrager(trial, bulk, shear, set.strength, P.plasticShearStrain[p]);
+				const ReturnResult r = mohrCoulomb ? returnMohrCoulomb(trial, bulk, shear, set.strength, P.plasticShearStrain[p])
+				                                   : returnDruckerPrager(trial, bulk, shear, set.strength, P.plasticShearStrain[p]);
 				P.effectiveStress[p] = matrixToVoigt(r.stress);
 				P.plasticShearStrain[p] += r.plasticShearStrain;
 			} else {

@@ -25,7 +25,8 @@ mpm::SkeletonModel MpmSoilMat::skeletonModel() const
 {
 	if (model == "linearElastic") return mpm::SkeletonModel::LinearElastic;
 	if (model == "DruckerPrager") return mpm::SkeletonModel::DruckerPrager;
-	throw mpm::InvalidParameter("model = '" + model + "' is not one of: linearElastic, DruckerPrager");
+	if (model == "MohrCoulomb") return mpm::SkeletonModel::MohrCoulomb;
+	throw mpm::InvalidParameter("model = '" + model + "' is not one of: linearElastic, DruckerPrager, MohrCoulomb");
 }
 
 mpm::StrengthParameters MpmSoilMat::strength() const
@@ -83,7 +84,8 @@ const AttrTable<MpmSoilMat>& MpmSoilMat::attributes()
 		realAttr("porosity", &M::porosity, "Initial porosity n0 [-], in (0, 1)"),
 		realAttr("intrinsicPermeability", &M::intrinsicPermeability,
 		         "Intrinsic permeability κ [m²], > 0; the hydraulic conductivity is k = κ ρw |g| / μw [m s⁻¹] with the engine's gravity"),
-		stringAttr("model", &M::model, "Skeleton model [-]: 'linearElastic' or 'DruckerPrager' (non-associated cone matched to Mohr–Coulomb in plane strain)"),
+		stringAttr("model", &M::model,
+		           "Skeleton model [-]: 'linearElastic', 'DruckerPrager' (non-associated cone matched to Mohr–Coulomb in plane strain) or 'MohrCoulomb' (non-associated, principal stresses)"),
 		realAttr("frictionAngle", &M::frictionAngle, "Peak friction angle φ [rad], 0 < φ < π/2"),
 		realAttr("dilatancyAngle", &M::dilatancyAngle, "Dilatancy angle ψ [rad], 0 ≤ ψ ≤ φ"),
 		realAttr("cohesion", &M::cohesion, "Cohesion c [Pa], ≥ 0"),

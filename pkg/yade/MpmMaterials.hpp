@@ -18,7 +18,7 @@ public:
 	yade::Real porosity              = mpm::SoilParameters {}.porosity;              // n0 [-]
 	yade::Real intrinsicPermeability = mpm::SoilParameters {}.intrinsicPermeability; // κ [m²]
 	bool       kozenyCarman          = false; // κ(n) by the Kozeny–Carman ratio
-	std::string model                 = "linearElastic"; // linearElastic | DruckerPrager
+	std::string model                 = "linearElastic"; // linearElastic | DruckerPrager | MohrCoulomb
 	yade::Real frictionAngle          = mpm::StrengthParameters {}.frictionAngle;         // φ [rad]
 	yade::Real dilatancyAngle         = mpm::StrengthParameters {}.dilatancyAngle;        // ψ [rad]
 	yade::Real cohesion               = mpm::StrengthParameters {}.cohesion;              // c [Pa]

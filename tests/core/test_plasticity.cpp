@@ -3,6 +3,8 @@
 #include "core/Errors.hpp"
 #include "core/Plasticity.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -179,6 +181,101 @@ TEST(StrengthParameters, RangesAreChecked)
 	p                       = {};
 	p.residualFrictionAngle = 45 * degree;
 	EXPECT_THROW(p.validate(), InvalidParameter);
+}
+
+} // namespace
+
+namespace {
+
+using namespace mpm;
+
+struct McPoint {
+	Mat3 stress;
+	Real kappa = 0;
+	void strain(const Mat3& de, const StrengthParameters& p)
+	{
+		const ReturnResult r = returnMohrCoulomb(elasticTrial(stress, de), K, G, p, kappa);
+		stress               = r.stress;
+		kappa += r.plasticShearStrain;
+	}
+};
+
+// Drive with axial strain dε_zz; σ_xx held at `lateral` by bisection on ε_xx; ε_yy = ε_xx
+// (axisymmetric) or 0 (plane strain).
+void mcStep(McPoint& pt, Real dez, Real lateral, bool planeStrain, const StrengthParameters& p)
+{
+	Real lo = -1e-2, hi = 1e-2;
+	for (int i = 0; i < 80; ++i) {
+		const Real mid = 0.5 * (lo + hi);
+		McPoint    t   = pt;
+		t.strain(Vec3(mid, planeStrain ? 0 : mid, dez).asDiagonal(), p);
+		(t.stress(0, 0) > lateral ? hi : lo) = mid;
+	}
+	pt.strain(Vec3(0.5 * (lo + hi), planeStrain ? 0 : 0.5 * (lo + hi), dez).asDiagonal(), p);
+}
+
+// Mohr–Coulomb: σ1 = σ3 (1 + sin φ)/(1 − sin φ) + 2c cos φ/(1 − sin φ) (compression-positive) at
+// failure, whatever σ2: triaxial compression, triaxial extension and plane strain all give it.
+TEST(MohrCoulomb, FailureCriterionHoldsInCompressionExtensionAndPlaneStrain)
+{
+	for (Real phi : { 30.0, 38.0 }) {
+		StrengthParameters p;
+		p.frictionAngle         = phi * degree;
+		p.residualFrictionAngle = p.frictionAngle;
+		p.dilatancyAngle        = 5 * degree;
+		p.cohesion              = 2e3;
+		p.tensionCutoff         = 1e9;
+		const Real P0 = 40e3, sp = std::sin(p.frictionAngle), cp = std::cos(p.frictionAngle);
+		auto criterion = [&](const Mat3& s) { // (σ1 − σ3) − (σ1 + σ3) sin φ − 2c cos φ with σ compression-positive
+			Eigen::SelfAdjointEigenSolver<Mat3> e(-s);
+			const Real s1 = e.eigenvalues()[2], s3 = e.eigenvalues()[0];
+			return (s1 - s3) - (s1 + s3) * sp - 2 * p.cohesion * cp;
+		};
+		// triaxial compression: σ3 = σ2 = P0 lateral, σ1 axial
+		McPoint tc { -P0 * Mat3::Identity() };
+		for (int i = 0; i < 1500; ++i) mcStep(tc, -2e-5, -P0, false, p);
+		EXPECT_NEAR(-tc.stress(2, 2), P0 * (1 + sp) / (1 - sp) + 2 * p.cohesion * cp / (1 - sp), 1e-6 * P0) << "compression, φ = " << phi;
+		// triaxial extension: axial unloading under constant lateral σ1 = σ2 = P0: σ3 axial
+		McPoint te { -P0 * Mat3::Identity() };
+		for (int i = 0; i < 1500; ++i) mcStep(te, 2e-5, -P0, false, p);
+		EXPECT_NEAR(-te.stress(2, 2), (P0 * (1 - sp) - 2 * p.cohesion * cp) / (1 + sp), 1e-6 * P0) << "extension, φ = " << phi;
+		// plane strain
+		McPoint ps { -P0 * Mat3::Identity() };
+		for (int i = 0; i < 1500; ++i) mcStep(ps, -2e-5, -P0, true, p);
+		EXPECT_NEAR(criterion(ps.stress), 0, 1e-6 * P0) << "plane strain, φ = " << phi;
+		EXPECT_GT(tc.kappa, 0);
+	}
+}
+
+TEST(MohrCoulomb, PlaneReturnDilatesAsTheFlowRuleSays)
+{
+	// On the plane, Δε^p = Δλ b with b = (1 − sin ψ, 0, −(1 + sin ψ)) (compression-positive):
+	// Δε_v^p / (Δε1^p − Δε3^p) = −sin ψ, a dilation for ψ > 0.
+	StrengthParameters p;
+	p.frictionAngle         = 35 * degree;
+	p.residualFrictionAngle = p.frictionAngle;
+	p.dilatancyAngle        = 12 * degree;
+	const Mat3 trial        = -Vec3(30e3, 50e3, 120e3).asDiagonal().toDenseMatrix(); // σ_zz most compressive, σ2 distinct
+	const auto r            = returnMohrCoulomb(trial, K, G, p, 0);
+	ASSERT_TRUE(r.yielded);
+	// plastic strain = C (trial − returned), C the elastic compliance
+	const Mat3 ds  = trial - r.stress;
+	const Mat3 dep = (ds - (K - 2 * G / 3) / (3 * K) * ds.trace() * Mat3::Identity()) / (2 * G);
+	const Real e1 = -dep(2, 2), e3 = -dep(0, 0), ev = -dep.trace();
+	EXPECT_NEAR(ev / (e1 - e3), -std::sin(p.dilatancyAngle), 1e-9);
+	EXPECT_NEAR(dep(1, 1), 0, 1e-15); // no plastic strain along the intermediate stress on the plane
+}
+
+TEST(MohrCoulomb, ElasticInsideAndStressFreeApexForCohesionlessSand)
+{
+	StrengthParameters p;
+	const Mat3         inside = -Vec3(40e3, 45e3, 50e3).asDiagonal().toDenseMatrix();
+	const auto         r      = returnMohrCoulomb(inside, K, G, p, 0);
+	EXPECT_FALSE(r.yielded);
+	EXPECT_EQ(r.stress, inside);
+	const auto t = returnMohrCoulomb(Vec3(3e3, 1e3, -2e3).asDiagonal().toDenseMatrix(), K, G, p, 0); // partly tensile
+	EXPECT_TRUE(t.yielded);
+	EXPECT_LT(t.stress.norm(), 1e-6); // c = 0, σ_t = 0: the apex is stress-free
 }
 
 } // namespace
