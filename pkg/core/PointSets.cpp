@@ -114,4 +114,29 @@ void WaterPointSet::validate(const std::string& setName) const
 	requirePorosity(setName, porosity, true);
 }
 
+namespace {
+	template <class Field> void compact(Field& f, const std::vector<char>& remove)
+	{
+		std::size_t out = 0;
+		for (std::size_t p = 0; p < f.size(); ++p)
+			if (!remove[p]) f[out++] = f[p];
+		f.resize(out);
+	}
+} // namespace
+
+Real WaterPointSet::removeWhere(const std::vector<char>& remove)
+{
+	Real removed = 0;
+	for (std::size_t p = 0; p < size(); ++p)
+		if (remove[p]) removed += mass[p];
+	compact(position, remove);
+	compact(velocity, remove);
+	compact(mass, remove);
+	compact(volume, remove);
+	compact(halfLength, remove);
+	compact(porePressure, remove);
+	compact(porosity, remove);
+	return removed;
+}
+
 } // namespace mpm

@@ -47,6 +47,9 @@ struct WaterPointSet : MaterialPointSet {
 
 	void resize(std::size_t n);
 	void validate(const std::string& setName) const;
+	// Remove the points whose `remove` flag is set, keeping the order of the others; returns the
+	// mass removed [kg].
+	Real removeWhere(const std::vector<char>& remove);
 };
 
 } // namespace mpm

@@ -192,6 +192,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 			check(updatePointKinematics<Kernel>(grid_, fields_.waterVelocity, fields_.waterVelocityNew, *waters_[w], dt, settings_.flipBlend), "water", w,
 			      *waters_[w]);
 	}
+	removeOutflowingWater();
 	throwIfOutsideGrid();
 	{
 		StageTimer                           t(stageSeconds_, Stage::RemapVelocities);
@@ -229,6 +230,30 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	if (settings_.shapeFunction == ShapeFunction::CpGimp) {
 		StageTimer t(stageSeconds_, Stage::UpdateDomains);
 		for (SolidSet& s : solids_) updateDomainsCpGimp(*s.points, grid_.cellSize);
+	}
+}
+
+// Water points in a sink, or (when allowed) leaving the grid, leave the model; their mass is
+// accounted in removedWaterMass (theory.md §2.4). Their nodal mass of this step is already spent.
+void TwoPhaseSolver::removeOutflowingWater()
+{
+	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid) return;
+	for (WaterPointSet* w : waters_) {
+		const std::size_t n = w->size();
+		removeFlags_.assign(n, 0);
+		bool any = false;
+		for (std::size_t p = 0; p < n; ++p) {
+			bool out = false;
+			for (const WaterSink& sink : domain_.sinks) out = out || sink.contains(w->position[p]);
+			if (!out && domain_.removeWaterLeavingGrid)
+				for (int d = 0; d < 3; ++d) { // the widest (GIMP) stencil must fit in the grid
+					const Real u = (w->position[p][d] - grid_.origin[d]) / grid_.cellSize;
+					out          = out || !std::isfinite(u) || std::floor(u - 0.5) < 0 || std::floor(u - 0.5) + GimpKernel::stencil > grid_.nodes[d];
+				}
+			removeFlags_[p] = out;
+			any             = any || out;
+		}
+		if (any) removedWaterMass_ += w->removeWhere(removeFlags_);
 	}
 }
 

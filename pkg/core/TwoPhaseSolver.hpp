@@ -21,12 +21,20 @@ struct SolverSettings {
 	void          validate() const;
 };
 
+// A box in which water points are removed (an outflow sink, e.g. the filtering cloth of a flume).
+struct WaterSink {
+	Vec3 lower, upper; // [m]
+	bool contains(const Vec3& x) const { return (x.array() >= lower.array()).all() && (x.array() <= upper.array()).all(); }
+};
+
 // The domain box (walls on its faces) and the grid cell size.
 struct Domain {
-	Vec3               lower    = Vec3::Zero(); // [m]
-	Vec3               upper    = Vec3::Ones(); // [m]
-	Real               cellSize = 0.1;          // h [m]
-	BoundaryConditions boundaries;
+	Vec3                   lower    = Vec3::Zero(); // [m]
+	Vec3                   upper    = Vec3::Ones(); // [m]
+	Real                   cellSize = 0.1;          // h [m]
+	BoundaryConditions     boundaries;
+	std::vector<WaterSink> sinks;                    // water points entering one are removed
+	bool                   removeWaterLeavingGrid = true; // else a water point leaving the grid stops the run
 };
 
 // Time-step limits of the current state (theory.md §5, eqs. 5.1–5.2), before the safety factor.
@@ -65,6 +73,7 @@ public:
 	long advance(Real dt);
 
 	long                                                stepCount() const { return steps_; }
+	Real                                                removedWaterMass() const { return removedWaterMass_; } // total, all sets [kg]
 	const std::array<double, static_cast<int>(Stage::Count)>& stageSeconds() const { return stageSeconds_; }
 	const GridGeometry&                                 grid() const { return grid_; }
 	const GridFields&                                   fields() const { return fields_; }
@@ -89,6 +98,9 @@ private:
 	Real                          waterMassTolerance_ = 0;
 	long                          steps_              = 0;
 	bool                          waterFieldsZero_    = false; // the water nodal arrays hold zeros (dry steps skip them)
+	Real                          removedWaterMass_   = 0;     // water mass removed by sinks and at the grid's edge [kg]
+	void                          removeOutflowingWater();
+	std::vector<char>             removeFlags_;
 	std::array<double, static_cast<int>(Stage::Count)> stageSeconds_ {};
 };
 

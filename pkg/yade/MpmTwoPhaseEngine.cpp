@@ -64,6 +64,13 @@ mpm::Domain MpmTwoPhaseEngine::domain() const
 			mpm::throwOutOfRange("drainedWaterTable[" + std::string(faceNames[f]) + "]", wall.waterTable, "m", "[-inf (none), inf)");
 		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + std::string(faceNames[f]) + "]", wall.drainedPressure, "Pa", "finite values");
 	}
+	d.removeWaterLeavingGrid = removeWaterLeavingGrid;
+	if (waterSinks.size() % 2) throw mpm::InvalidParameter("waterSinks must hold (lower, upper) corner pairs; it has " + std::to_string(waterSinks.size()) + " corners");
+	for (std::size_t i = 0; i + 1 < waterSinks.size(); i += 2) {
+		if (!(waterSinks[i].array() <= waterSinks[i + 1].array()).all() || !waterSinks[i].allFinite() || !waterSinks[i + 1].allFinite())
+			mpm::throwOutOfRange("waterSinks[" + std::to_string(i / 2) + "] upper − lower", (waterSinks[i + 1] - waterSinks[i]).transpose(), "m", "finite, non-negative components");
+		d.sinks.push_back(mpm::WaterSink { waterSinks[i], waterSinks[i + 1] });
+	}
 	for (int a = 0; a < 3; ++a)
 		if (!(domainMax[a] > domainMin[a])) mpm::throwOutOfRange("domainMax - domainMin", (domainMax - domainMin).transpose(), "m", "positive components");
 	return d;
@@ -118,6 +125,7 @@ void MpmTwoPhaseEngine::action()
 	criticalTimeStep = solver_->timeStepLimits().critical;
 	subStepsLast     = solver_->advance(dt);
 	solverSteps      = solver_->stepCount();
+	removedWaterMass = removedBefore_ + solver_->removedWaterMass();
 	solidPointCount  = solid;
 	waterPointCount  = fluid;
 	lastDt           = dt;
@@ -129,6 +137,7 @@ void MpmTwoPhaseEngine::action()
 void MpmTwoPhaseEngine::callPostLoad()
 {
 	yade::GlobalEngine::callPostLoad();
+	if (solver_) removedBefore_ += solver_->removedWaterMass(); // keep the total across rebuilds
 	solver_.reset(); // any change of the set-up rebuilds the grid and the constraints
 	try {
 		settings();
@@ -154,6 +163,22 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		fixedListAttr("solidWalls", &E::solidWalls, 6, "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0) or 'fixed'"),
 		fixedListAttr("waterWalls", &E::waterWalls, 6, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
 		fixedListAttr("drainedPressure", &E::drainedPressure, 6, "Uniform part of the pore pressure p̄ held on each 'drained' face [Pa]"),
+		AttrSpec<E> { "waterSinks", "Boxes in which water points are removed (outflow, e.g. a filtering cloth), as a list of (lower, upper) corner pairs [m]",
+		              [](const E& e) {
+			              py::list l;
+			              for (std::size_t i = 0; i + 1 < e.waterSinks.size(); i += 2) l.append(py::make_tuple(e.waterSinks[i], e.waterSinks[i + 1]));
+			              return py::object(l);
+		              },
+		              [](E& e, const py::object& v) {
+			              std::vector<yade::Vector3r> corners;
+			              for (long i = 0; i < py::len(v); ++i) {
+				              if (py::len(v[i]) != 2) raisePython(PyExc_ValueError, "waterSinks entries must be (lower, upper) pairs of 3-vectors [m]");
+				              corners.push_back(toVector3("waterSinks", v[i][0]));
+				              corners.push_back(toVector3("waterSinks", v[i][1]));
+			              }
+			              e.waterSinks = corners;
+		              } },
+		boolAttr("removeWaterLeavingGrid", &E::removeWaterLeavingGrid, "Remove water points that leave the grid and count their mass in removedWaterMass (else the run stops) [-]"),
 		fixedListAttr("drainedWaterTable", &E::drainedWaterTable, 6,
 		              "Per 'drained' face, the elevation of a free water surface [m] adding the hydrostatic part ρw |g| max(0, table − z) to p̄ (z measured against gravity); -inf: none"),
 		readOnly(intAttr("stepsDone", &E::stepsDone, "Number of times the engine ran [-]")),
@@ -164,6 +189,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		readOnly(intAttr("waterPointCount", &E::waterPointCount, "Water points advanced by the last run [-]")),
 		readOnly(intAttr("subStepsLast", &E::subStepsLast, "Explicit sub-steps taken by the last run [-]")),
 		readOnly(intAttr("solverSteps", &E::solverSteps, "Explicit steps since the solver was (re)built [-]")),
+		readOnly(realAttr("removedWaterMass", &E::removedWaterMass, "Water mass removed by waterSinks and at the grid's edge since the start [kg]")),
 		readOnly(realAttr("criticalTimeStep", &E::criticalTimeStep,
 		                  "Critical time step of the last run before timeStepFactor: min of the wave limit h/(fastest wave + fastest point) and, with explicit drag, the drag limit [s]")),
 	};
@@ -192,6 +218,10 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& BOOST_SERIALIZATION_NVP(waterWalls);
 	ar& BOOST_SERIALIZATION_NVP(drainedPressure);
 	ar& BOOST_SERIALIZATION_NVP(drainedWaterTable);
+	serializeFlat(ar, "waterSinks", waterSinks);
+	ar& BOOST_SERIALIZATION_NVP(removeWaterLeavingGrid);
+	ar& BOOST_SERIALIZATION_NVP(removedWaterMass);
+	if (Archive::is_loading::value) removedBefore_ = removedWaterMass;
 	ar& BOOST_SERIALIZATION_NVP(stepsDone);
 	ar& BOOST_SERIALIZATION_NVP(mpmTime);
 	ar& BOOST_SERIALIZATION_NVP(lastIter);

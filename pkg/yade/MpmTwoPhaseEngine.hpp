@@ -28,6 +28,8 @@ public:
 	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed
 	std::vector<std::string> waterWalls { 6, "free" };      // free | impermeable | drained
 	std::vector<yade::Real>  drainedPressure = std::vector<yade::Real>(6, 0.0); // p̄ per face [Pa]
+	std::vector<yade::Vector3r> waterSinks;             // (lower, upper) corner pairs of sink boxes [m]
+	bool                        removeWaterLeavingGrid = true; // water leaving the grid is removed (else: stop)
 	std::vector<yade::Real>  drainedWaterTable = std::vector<yade::Real>(6, -std::numeric_limits<yade::Real>::infinity()); // [m], -inf: none
 
 	// outputs (read-only from Python)
@@ -40,6 +42,7 @@ public:
 	long       subStepsLast    = 0;  // sub-steps of the last action() [-]
 	long       solverSteps     = 0;  // explicit steps since the solver was set up [-]
 	yade::Real criticalTimeStep = 0; // critical step of the last action(), before timeStepFactor [s]
+	yade::Real removedWaterMass = 0; // water mass removed by sinks and at the grid's edge, in total [kg]
 
 	MpmTwoPhaseEngine() = default;
 	~MpmTwoPhaseEngine() override;
@@ -55,7 +58,8 @@ public:
 	const mpm::TwoPhaseSolver* solver() const { return solver_.get(); }
 
 private:
-	std::unique_ptr<mpm::TwoPhaseSolver> solver_; // not serialized: rebuilt on first action()
+	std::unique_ptr<mpm::TwoPhaseSolver> solver_;  // not serialized: rebuilt on first action()
+	yade::Real                           removedBefore_ = 0; // removed by solvers before the current one [kg]
 };
 
 } // namespace yade_mpm
