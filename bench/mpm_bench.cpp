@@ -58,12 +58,7 @@ int main(int argc, char** argv)
 	WaterPointSet fluid   = fixtures::waterLattice(lattice, soil.porosity, water.density);
 	fixtures::setGeostatic(solid, fluid, soil, water, g, side);
 	const std::size_t n = solid.size();
-	Domain d;
-	d.upper    = Vec3::Constant(side);
-	d.cellSize = h;
-	for (int f = 0; f < 4; ++f) d.boundaries.walls[f] = { SolidWall::Slip, WaterWall::Impermeable };
-	d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
-	d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Drained };
+	const Domain d = fixtures::columnDomain(Vec3::Constant(side), h);
 	SolverSettings s;
 	s.gravity = Vec3(0, 0, -g);
 	TwoPhaseSolver solver(d, s);

@@ -29,12 +29,7 @@ struct Column {
 		solid        = fixtures::solidLattice(l, soil.porosity, soil.density);
 		fluid        = fixtures::waterLattice(l, soil.porosity, water.density);
 		fixtures::setGeostatic(solid, fluid, soil, water, g, H);
-		Domain d;
-		d.upper    = Vec3(h, h, H);
-		d.cellSize = h;
-		for (int f = 0; f < 4; ++f) d.boundaries.walls[f] = { SolidWall::Slip, WaterWall::Impermeable };
-		d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
-		d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Drained };
+		const Domain d = fixtures::columnDomain(Vec3(h, h, H), h);
 		SolverSettings s;
 		s.gravity = Vec3(0, 0, -g);
 		s.drag    = drag;

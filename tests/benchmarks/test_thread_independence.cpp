@@ -29,12 +29,7 @@ State run(int threads)
 		const Vec3& x     = s.fluid.position[p];
 		s.fluid.velocity[p] = 0.01 * Vec3(std::sin(20 * x.y()), std::cos(20 * x.z()), std::sin(20 * x.x()));
 	}
-	Domain d;
-	d.upper    = Vec3::Constant(side);
-	d.cellSize = h;
-	for (int f = 0; f < 4; ++f) d.boundaries.walls[f] = { SolidWall::Slip, WaterWall::Impermeable };
-	d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
-	d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Drained };
+	const Domain d = fixtures::columnDomain(Vec3::Constant(side), h);
 	SolverSettings settings;
 	settings.gravity = Vec3(0, 0, -9.81);
 	TwoPhaseSolver solver(d, settings);

@@ -20,16 +20,21 @@ constexpr Real degree = M_PI / 180;
 
 Mat3 elasticTrial(const Mat3& s, const Mat3& de) { return s + (K - 2 * G / 3) * de.trace() * Mat3::Identity() + 2 * G * de; }
 
-struct Point {
+using ReturnMapping = ReturnResult (*)(const Mat3&, Real, Real, const StrengthParameters&, Real);
+
+// A material point driven by strain increments through one return mapping.
+template <ReturnMapping Return> struct Driven {
 	Mat3 stress;
 	Real kappa = 0;
 	void strain(const Mat3& de, const StrengthParameters& p)
 	{
-		const ReturnResult r = returnDruckerPrager(elasticTrial(stress, de), K, G, p, kappa);
+		const ReturnResult r = Return(elasticTrial(stress, de), K, G, p, kappa);
 		stress               = r.stress;
 		kappa += r.plasticShearStrain;
 	}
 };
+using Point   = Driven<returnDruckerPrager>;
+using McPoint = Driven<returnMohrCoulomb>;
 
 Real meanP(const Mat3& s) { return -s.trace() / 3; }
 Real tauOf(const Mat3& s)
@@ -38,14 +43,14 @@ Real tauOf(const Mat3& s)
 	return std::sqrt(0.5 * d.squaredNorm());
 }
 
-// One strain step with axial compression dε_zz, lateral strain found so that σ_xx stays at
-// `lateral` (bisection), and ε_yy either equal to ε_xx (triaxial) or held at 0 (plane strain).
-void stressControlledStep(Point& pt, Real dez, Real lateral, bool planeStrain, const StrengthParameters& p)
+// One strain step with axial strain dε_zz, lateral strain found so that σ_xx stays at `lateral`
+// (bisection), and ε_yy either equal to ε_xx (axisymmetric) or held at 0 (plane strain).
+template <class Pt> void stressControlledStep(Pt& pt, Real dez, Real lateral, bool planeStrain, const StrengthParameters& p)
 {
 	Real lo = -1e-2, hi = 1e-2;
 	for (int i = 0; i < 80; ++i) {
 		const Real mid = 0.5 * (lo + hi);
-		Point      t   = pt;
+		Pt         t   = pt;
 		t.strain(Vec3(mid, planeStrain ? 0 : mid, dez).asDiagonal(), p);
 		(t.stress(0, 0) > lateral ? hi : lo) = mid; // more lateral extension → more tensile σ_xx
 	}
@@ -189,31 +194,6 @@ namespace {
 
 using namespace mpm;
 
-struct McPoint {
-	Mat3 stress;
-	Real kappa = 0;
-	void strain(const Mat3& de, const StrengthParameters& p)
-	{
-		const ReturnResult r = returnMohrCoulomb(elasticTrial(stress, de), K, G, p, kappa);
-		stress               = r.stress;
-		kappa += r.plasticShearStrain;
-	}
-};
-
-// Drive with axial strain dε_zz; σ_xx held at `lateral` by bisection on ε_xx; ε_yy = ε_xx
-// (axisymmetric) or 0 (plane strain).
-void mcStep(McPoint& pt, Real dez, Real lateral, bool planeStrain, const StrengthParameters& p)
-{
-	Real lo = -1e-2, hi = 1e-2;
-	for (int i = 0; i < 80; ++i) {
-		const Real mid = 0.5 * (lo + hi);
-		McPoint    t   = pt;
-		t.strain(Vec3(mid, planeStrain ? 0 : mid, dez).asDiagonal(), p);
-		(t.stress(0, 0) > lateral ? hi : lo) = mid;
-	}
-	pt.strain(Vec3(0.5 * (lo + hi), planeStrain ? 0 : 0.5 * (lo + hi), dez).asDiagonal(), p);
-}
-
 // Mohr–Coulomb: σ1 = σ3 (1 + sin φ)/(1 − sin φ) + 2c cos φ/(1 − sin φ) (compression-positive) at
 // failure, whatever σ2: triaxial compression, triaxial extension and plane strain all give it.
 TEST(MohrCoulomb, FailureCriterionHoldsInCompressionExtensionAndPlaneStrain)
@@ -233,15 +213,15 @@ TEST(MohrCoulomb, FailureCriterionHoldsInCompressionExtensionAndPlaneStrain)
 		};
 		// triaxial compression: σ3 = σ2 = P0 lateral, σ1 axial
 		McPoint tc { -P0 * Mat3::Identity() };
-		for (int i = 0; i < 1500; ++i) mcStep(tc, -2e-5, -P0, false, p);
+		for (int i = 0; i < 1500; ++i) stressControlledStep(tc, -2e-5, -P0, false, p);
 		EXPECT_NEAR(-tc.stress(2, 2), P0 * (1 + sp) / (1 - sp) + 2 * p.cohesion * cp / (1 - sp), 1e-6 * P0) << "compression, φ = " << phi;
 		// triaxial extension: axial unloading under constant lateral σ1 = σ2 = P0: σ3 axial
 		McPoint te { -P0 * Mat3::Identity() };
-		for (int i = 0; i < 1500; ++i) mcStep(te, 2e-5, -P0, false, p);
+		for (int i = 0; i < 1500; ++i) stressControlledStep(te, 2e-5, -P0, false, p);
 		EXPECT_NEAR(-te.stress(2, 2), (P0 * (1 - sp) - 2 * p.cohesion * cp) / (1 + sp), 1e-6 * P0) << "extension, φ = " << phi;
 		// plane strain
 		McPoint ps { -P0 * Mat3::Identity() };
-		for (int i = 0; i < 1500; ++i) mcStep(ps, -2e-5, -P0, true, p);
+		for (int i = 0; i < 1500; ++i) stressControlledStep(ps, -2e-5, -P0, true, p);
 		EXPECT_NEAR(criterion(ps.stress), 0, 1e-6 * P0) << "plane strain, φ = " << phi;
 		EXPECT_GT(tc.kappa, 0);
 	}

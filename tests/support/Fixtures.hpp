@@ -3,6 +3,7 @@
 
 #include "core/Parameters.hpp"
 #include "core/PointSets.hpp"
+#include "core/TwoPhaseSolver.hpp"
 
 namespace mpm::fixtures {
 
@@ -67,6 +68,19 @@ inline void setGeostatic(SolidPointSet& solid, WaterPointSet& fluid, const SoilP
 		solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
 	}
 	for (std::size_t p = 0; p < fluid.size(); ++p) fluid.porePressure[p] = water.density * g * (top - fluid.position[p].z());
+}
+
+// A box [0, size] with the walls of a soil column: smooth impermeable sides, a fixed impermeable
+// base and a drained top.
+inline Domain columnDomain(const Vec3& size, Real cellSize)
+{
+	Domain d;
+	d.upper    = size;
+	d.cellSize = cellSize;
+	for (int f = 0; f < 4; ++f) d.boundaries.walls[f] = { SolidWall::Slip, WaterWall::Impermeable };
+	d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
+	d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Drained };
+	return d;
 }
 
 } // namespace mpm::fixtures
