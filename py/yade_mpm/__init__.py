@@ -34,7 +34,7 @@ _yade_mpm.registerClasses(yade.wrapper)
 self_test(_yade_mpm, yade.wrapper, yade.wrapper.Omega())
 
 from yade.wrapper import MpmHdf5Recorder, MpmSoilMat, MpmSolidPoints, MpmTwoPhaseEngine, MpmWaterMat, MpmWaterPoints  # noqa: E402
-from . import analytical, builders, results  # noqa: E402
+from . import analytical, builders, results, sandpile  # noqa: E402
 from .builders import saturated_block  # noqa: E402
 
 __version__ = _buildinfo.package_version

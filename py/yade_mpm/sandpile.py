@@ -1,0 +1,90 @@
+"""The saturated sand pile in a flume: one scene definition (geometry, materials, head history)
+shared by the MPM example and, later, the DEM + pore-fluid (PFV) version, which reads the same
+numbers instead of copying them.
+
+The source paper's flume, sand and head history are not available (doc: shared formulation §6);
+the values below are documented lab-scale choices, not the paper's:
+
+* flume 0.60 m long (x), 0.10 m wide (y); pile 0.12 m high with a 0.10 m crest, a 30° downstream
+  slope and a vertical upstream face against the inflow reservoir at x = 0;
+* dense quartz sand: ρs = 2650 kg m⁻³, n = 0.40, E = 20 MPa, ν = 0.3, φ = 36°, ψ = 6°, c = 0,
+  friction softening to 30° over κ_s = 0.05; k = 1e-3 m s⁻¹ (medium sand);
+* water: ρw = 1000 kg m⁻³, μw = 1e-3 Pa s, Kw lowered to 2.2e8 Pa for speed: Kw/n = 20 E_oed keeps
+  the water nearly incompressible for this quasi-static seepage (the formulation asks ≥ 10–100);
+* head at the inflow face rising linearly from the crest-free level 0.06 m to 0.14 m over 20 s.
+"""
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SandPileScene:
+    flume_length: float = 0.60       # [m] along x
+    flume_width: float = 0.10        # [m] along y (front and rear walls at y = 0 and y = width)
+    flume_height: float = 0.20       # [m] domain height above the base
+    pile_height: float = 0.12        # [m]
+    crest_length: float = 0.10       # [m] flat top, starting at the inflow face x = 0
+    slope_angle: float = math.radians(30)  # [rad] downstream face
+    grain_density: float = 2650.0    # ρs [kg m⁻³]
+    porosity: float = 0.40           # n0 [-]
+    young_modulus: float = 20e6      # E [Pa]
+    poisson_ratio: float = 0.3       # ν [-]
+    friction_angle: float = math.radians(36)          # φ [rad]
+    dilatancy_angle: float = math.radians(6)          # ψ [rad]
+    residual_friction_angle: float = math.radians(30)  # φ_r [rad]
+    softening_strain: float = 0.05   # κ_s [-]
+    hydraulic_conductivity: float = 1e-3  # k [m s⁻¹]
+    water_density: float = 1000.0    # ρw [kg m⁻³]
+    water_viscosity: float = 1e-3    # μw [Pa s]
+    water_bulk_modulus: float = 2.2e8  # Kw [Pa]
+    head_start: float = 0.06         # inflow water level at t = 0 [m]
+    head_end: float = 0.14           # inflow water level at the end of the ramp [m]
+    head_ramp_time: float = 20.0     # [s]
+
+    def toe_x(self):
+        """x of the downstream toe [m]."""
+        return self.crest_length + self.pile_height / math.tan(self.slope_angle)
+
+    def surface_height(self, x):
+        """Height of the pile surface above the base at x [m] (0 beyond the toe)."""
+        x = np.asarray(x, dtype=float)
+        down = self.pile_height - (x - self.crest_length) * math.tan(self.slope_angle)
+        return np.where(x <= self.crest_length, self.pile_height, np.clip(down, 0, None))
+
+    def head(self, time):
+        """Inflow water level [m] at time t [s] (linear ramp, then held)."""
+        r = min(max(time / self.head_ramp_time, 0.0), 1.0)
+        return self.head_start + r * (self.head_end - self.head_start)
+
+    def intrinsic_permeability(self, gravity):
+        """κ = k μw / (ρw |g|) [m²] for the scene's gravity vector [m s⁻²]."""
+        return self.hydraulic_conductivity * self.water_viscosity / (self.water_density * float(np.linalg.norm(gravity)))
+
+    def validate(self):
+        if not (0 < self.slope_angle < math.pi / 2):
+            raise ValueError("slope_angle = %r rad is outside the valid range (0, π/2)" % self.slope_angle)
+        if self.toe_x() >= self.flume_length:
+            raise ValueError("the pile's toe x = %.3f m lies beyond the flume length %.3f m" % (self.toe_x(), self.flume_length))
+        if self.pile_height >= self.flume_height:
+            raise ValueError("pile_height = %r m must be below flume_height = %r m" % (self.pile_height, self.flume_height))
+
+
+DEFAULT = SandPileScene()
+
+
+def pile_points(scene, cell_size, points_per_cell=2):
+    """Centres of the lattice points (points_per_cell per cell and axis) inside the pile, and the
+    point spacing [m]. Points are kept where their centre lies below the pile surface."""
+    scene.validate()
+    spacing = cell_size / points_per_cell
+    nx = int(round(scene.flume_length / spacing))
+    ny = int(round(scene.flume_width / spacing))
+    nz = int(round(scene.pile_height / spacing))
+    x = spacing * (np.arange(nx) + 0.5)
+    y = spacing * (np.arange(ny) + 0.5)
+    z = spacing * (np.arange(nz) + 0.5)
+    X, Y, Z = np.meshgrid(x, y, z, indexing="ij")
+    inside = Z < scene.surface_height(X)
+    return np.stack([X[inside], Y[inside], Z[inside]], axis=1), spacing

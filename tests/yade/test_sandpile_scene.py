@@ -1,0 +1,38 @@
+"""The shared sand-pile scene definition: geometry and head history as documented."""
+import math
+
+import numpy as np
+import pytest
+
+from yade_mpm import sandpile
+
+
+def test_pile_geometry_volume_and_points():
+    s = sandpile.DEFAULT
+    assert s.toe_x() == pytest.approx(0.10 + 0.12 / math.tan(math.radians(30)))
+    # volume of crest rectangle + slope triangle, times the width
+    volume = (s.crest_length * s.pile_height + 0.5 * s.pile_height * (s.toe_x() - s.crest_length)) * s.flume_width
+    points, spacing = sandpile.pile_points(s, cell_size=0.01, points_per_cell=2)
+    assert len(points) * spacing ** 3 == pytest.approx(volume, rel=0.02)  # staircase of half-cells
+    assert np.all(points[:, 2] < s.surface_height(points[:, 0]))
+    assert points[:, 0].max() < s.toe_x()
+
+
+def test_head_history_and_permeability():
+    s = sandpile.DEFAULT
+    assert s.head(0) == s.head_start and s.head(1e9) == s.head_end
+    assert s.head(s.head_ramp_time / 2) == pytest.approx(0.5 * (s.head_start + s.head_end))
+    # k = κ ρw g / μw: 1e-3 m/s back from κ with the gravity given
+    kappa = s.intrinsic_permeability((0, 0, -9.81))
+    assert kappa * s.water_density * 9.81 / s.water_viscosity == pytest.approx(s.hydraulic_conductivity)
+
+
+def test_water_stays_nearly_incompressible():
+    s = sandpile.DEFAULT
+    e_oed = s.young_modulus * (1 - s.poisson_ratio) / ((1 + s.poisson_ratio) * (1 - 2 * s.poisson_ratio))
+    assert s.water_bulk_modulus / s.porosity >= 10 * e_oed
+
+
+def test_invalid_scene_is_refused():
+    with pytest.raises(ValueError, match="toe"):
+        sandpile.pile_points(sandpile.SandPileScene(flume_length=0.2), 0.01)
