@@ -46,6 +46,7 @@ struct WaterNode {
 	Vec3 weight;        // Σ S m_wp b [N]
 	Vec3 porousForce;   // Σ V_wp p (n ∇S + S ∇n), the −n∇p force on the water [N]
 	Vec3 pressureForce; // f^p_I = Σ V_wp p ∇S, pore-pressure part of the mixture force [N]
+	Real volume;        // Σ S V_wp, mixture volume carried by water points [m³] (free-surface detection)
 };
 
 inline SolidNode& operator+=(SolidNode& a, const SolidNode& b)
@@ -65,6 +66,7 @@ inline WaterNode& operator+=(WaterNode& a, const WaterNode& b)
 	a.weight += b.weight;
 	a.porousForce += b.porousForce;
 	a.pressureForce += b.pressureForce;
+	a.volume += b.volume;
 	return a;
 }
 

@@ -37,7 +37,7 @@ namespace {
 	// Race-free scatter: thread 0 adds into `target`, the others into private copies that are
 	// then summed node by node. Results differ between thread counts only by round-off.
 	inline SolidNode zeroOf(const SolidNode&) { return SolidNode { 0, Vec3::Zero(), Vec3::Zero(), 0, 0, 0 }; }
-	inline WaterNode zeroOf(const WaterNode&) { return WaterNode { 0, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero() }; }
+	inline WaterNode zeroOf(const WaterNode&) { return WaterNode { 0, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0 }; }
 	inline Vec3      zeroOf(const Vec3&) { return Vec3::Zero(); }
 
 	template <class Node, class F> void scatter(std::vector<Node>& target, std::vector<std::vector<Node>>& buffers, std::size_t count, F&& perPoint)
@@ -168,6 +168,7 @@ namespace stages {
 					node.weight += N * weight;
 					node.porousForce += (V * pressure) * (n * dN + N * gradN); // eq. 4.6
 					node.pressureForce += (V * pressure) * dN;                 // eq. 4.7
+					node.volume += N * V;
 				});
 			});
 		}
@@ -393,6 +394,32 @@ namespace stages {
 		for (std::size_t p = 0; p < count; ++p) {
 			P.porePressure[p] += dt * pressureRate[p];
 			P.volume[p] *= 1 + dt * waterDivergence[p];
+		}
+	}
+
+	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, WaterPointSet& P)
+	{
+		// full in-domain support volume of a node: h per axis inside the box, h/2 on a wall plane
+		const Real h      = grid.cellSize;
+		auto       full   = [&](int d, int i) { return i < grid.wallNode[d] || i > grid.upperWallNode[d] ? 0.0 : (i == grid.wallNode[d] || i == grid.upperWallNode[d] ? h / 2 : h); };
+		const std::size_t count = P.size();
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			weightsAt<GimpKernel>(grid, P.position[p], P.halfLength[p], w);
+			// the point's filling: Σ S_I (water volume of I / full support volume of I)
+			Real filling = 0;
+			for (int c = 0; c < 3; ++c)
+				for (int b = 0; b < 3; ++b)
+					for (int a = 0; a < 3; ++a) {
+						const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
+						if (N <= 0) continue;
+						const int  i = w[0].first + a, j = w[1].first + b, k = w[2].first + c;
+						const Real expected = full(0, i) * full(1, j) * full(2, k);
+						filling += N * (expected > 0 ? fields.water[grid.index(i, j, k)].volume / expected : 1.0);
+					}
+			const bool surface = filling < threshold;
+			if (surface) P.porePressure[p] = 0;
 		}
 	}
 

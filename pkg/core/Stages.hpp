@@ -111,6 +111,11 @@ namespace stages {
 	// Advance pore pressure and water volume with the (possibly cell-averaged) rates.
 	void updatePorePressure(const std::vector<Real>& pressureRate, const std::vector<Real>& waterDivergence, WaterPointSet& points, Real dt);
 
+	// Free surface (theory.md eq. 2.3): p = 0 on water points whose filling Σ S_I V^w_I/V^full_I
+	// (nodal water-point volume over the node's full in-domain support volume) is below `threshold`;
+	// with 2 points per cell and axis the outer layer has 0.625 and the next 0.875.
+	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, WaterPointSet& points);
+
 	// Step 11 (theory.md eq. 3.3): cpGIMP domains follow the stretch, l_i = l0_i F_ii in [0.01 h, h/2].
 	void updateDomainsCpGimp(SolidPointSet& points, Real cellSize);
 

@@ -57,6 +57,7 @@ void SolverSettings::validate() const
 {
 	requireClosedRange("flipBlend", flipBlend, 0, 1, "");
 	requireOpenRange("timeStepFactor", timeStepFactor, 0, 1 + 1e-15, "");
+	if (!(freeSurfaceThreshold >= 0 && freeSurfaceThreshold < 1)) throwOutOfRange("freeSurfaceThreshold", freeSurfaceThreshold, "", "[0, 1)");
 	if (!gravity.allFinite()) throw InvalidParameter("gravity must have finite components [m s⁻²]");
 }
 
@@ -224,6 +225,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 				averageOverCells(grid_, *w, waterDivergence_, cellSum_, cellVolume_);
 			}
 			updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
+			if (settings_.freeSurfaceThreshold > 0) applyFreeSurface(grid_, fields_, settings_.freeSurfaceThreshold, *w);
 			applyDrainedFaces(grid_, domain_.boundaries, settings_.gravity, water_.density, *w);
 		}
 	}

@@ -18,6 +18,7 @@ struct SolverSettings {
 	Real          timeStepFactor = 0.5;  // C [-], 0 < C ≤ 1, applied to the critical step
 	Vec3          gravity        = Vec3::Zero(); // b [m s⁻²]
 	bool          cellAveragedVolumetricRate = true; // theory.md eq. 4.17 (pressure and B-bar)
+	Real          freeSurfaceThreshold       = 0;    // β [-], 0 ≤ β < 1: p = 0 on points filled below β (eq. 2.3); 0: off
 	void          validate() const;
 };
 

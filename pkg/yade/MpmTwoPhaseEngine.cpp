@@ -85,6 +85,7 @@ mpm::SolverSettings MpmTwoPhaseEngine::settings() const
 	s.timeStepFactor             = timeStepFactor;
 	s.gravity                    = gravity;
 	s.cellAveragedVolumetricRate = cellAveraging;
+	s.freeSurfaceThreshold       = freeSurfaceThreshold;
 	s.validate();
 	return s;
 }
@@ -160,6 +161,8 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		stringAttr("shapeFunction", &E::shapeFunction, "Shape functions [-]: 'linear', 'uGIMP' (constant point domains) or 'cpGIMP' (domains follow the stretch)"),
 		stringAttr("drag", &E::drag, "Drag integration [-]: 'semi-implicit' (no drag time-step limit) or 'explicit'"),
 		boolAttr("cellAveraging", &E::cellAveraging, "Cell-averaged volumetric rates for the pore pressure and the skeleton (suppresses the pressure checkerboard) [-]"),
+		realAttr("freeSurfaceThreshold", &E::freeSurfaceThreshold,
+		         "Free-surface detection β [-], 0 ≤ β < 1: water points whose filling Σ S V_water/V_full of their nodes is below β get p = 0 (0.75 keeps exactly the outer layer with 2 points per cell and axis); 0: off"),
 		fixedListAttr("solidWalls", &E::solidWalls, 6, "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0) or 'fixed'"),
 		fixedListAttr("waterWalls", &E::waterWalls, 6, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
 		fixedListAttr("drainedPressure", &E::drainedPressure, 6, "Uniform part of the pore pressure p̄ held on each 'drained' face [Pa]"),
@@ -214,6 +217,7 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& BOOST_SERIALIZATION_NVP(shapeFunction);
 	ar& BOOST_SERIALIZATION_NVP(drag);
 	ar& BOOST_SERIALIZATION_NVP(cellAveraging);
+	ar& BOOST_SERIALIZATION_NVP(freeSurfaceThreshold);
 	ar& BOOST_SERIALIZATION_NVP(solidWalls);
 	ar& BOOST_SERIALIZATION_NVP(waterWalls);
 	ar& BOOST_SERIALIZATION_NVP(drainedPressure);

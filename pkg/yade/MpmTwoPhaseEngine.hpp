@@ -25,6 +25,7 @@ public:
 	std::string    shapeFunction  = "uGIMP";                // linear | uGIMP | cpGIMP
 	std::string    drag           = "semi-implicit";        // semi-implicit | explicit
 	bool           cellAveraging  = true;                   // cell-averaged volumetric rates
+	yade::Real     freeSurfaceThreshold = 0;                // β [-]: p = 0 on water points filled below β; 0 off
 	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed
 	std::vector<std::string> waterWalls { 6, "free" };      // free | impermeable | drained
 	std::vector<yade::Real>  drainedPressure = std::vector<yade::Real>(6, 0.0); // p̄ per face [Pa]

@@ -276,3 +276,35 @@ TEST(FreeWater, HydrostaticPoolStaysAtRest)
 }
 
 } // namespace
+
+namespace {
+
+// Free-surface detection (theory.md eq. 2.3): a geostatic column whose top is not a wall (the
+// domain reaches 2h above it) keeps p = 0 on its outer point layer only, and stays at rest.
+TEST(FreeSurface, DetectsTheOuterLayerOfAColumnBelowTheDomainTop)
+{
+	using namespace mpm;
+	const double g = 9.81, H = 0.5, h = 0.05;
+	Column       c(H, h, 1e-4, g);
+	fixtures::setGeostatic(c.solid, c.fluid, c.soil, c.water, g, H);
+	c.domain.upper                    = Vec3(h, h, H + 2 * h);
+	c.settings.freeSurfaceThreshold   = 0.75;
+	c.start();
+	c.run(0.05);
+	const double gammaW = c.water.density * g;
+	double       pErr = 0, vmax = 0;
+	int          zeroed = 0;
+	for (std::size_t p = 0; p < c.fluid.size(); ++p) {
+		const double depth = H - c.fluid.position[p].z();
+		pErr               = std::max(pErr, std::abs(c.fluid.porePressure[p] - gammaW * depth) / (gammaW * H));
+		vmax               = std::max({ vmax, c.fluid.velocity[p].norm(), c.solid.velocity[p].norm() });
+		zeroed += c.fluid.porePressure[p] == 0;
+	}
+	std::printf("free surface: %d points at p = 0, max p error %.4f of γw H, max speed %.2e m/s\n", zeroed, pErr, vmax);
+	EXPECT_EQ(zeroed, 4); // the outer layer of the 2×2 points per layer, nothing deeper
+	// the outer layer (h/4 deep) is held at 0; it settles ~10 µm as it takes up its load: 1% margin
+	EXPECT_LT(pErr, 1.01 * h / (4 * H));
+	EXPECT_LT(vmax, 1e-4);
+}
+
+} // namespace
