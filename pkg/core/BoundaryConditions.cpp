@@ -34,14 +34,12 @@ void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions&
 		const int  plane     = upperFace ? grid.upperWallNode[axis] : grid.wallNode[axis];
 		Vec3       inward    = Vec3::Zero();
 		inward[axis]         = upperFace ? -1 : 1;
-		// ∫ N dA over the face: h per in-plane axis inside the box, h/2 on its edges
-		auto share = [&](int d, int i) { return i < grid.wallNode[d] || i > grid.upperWallNode[d] ? 0.0 : (i == grid.wallNode[d] || i == grid.upperWallNode[d] ? h / 2 : h); };
 		// centroid of N on the face, where a linearly varying p̄ gives ∫ p̄ N dA = p̄(centroid) ∫ N dA:
 		// the node itself inside, h/3 inwards on an edge (the tent is one-sided there)
 		auto centroidShift = [&](int d, int i) { return i == grid.wallNode[d] ? h / 3 : (i == grid.upperWallNode[d] ? -h / 3 : 0.0); };
 		for (int j = 0; j < grid.nodes[a1]; ++j)
 			for (int k = 0; k < grid.nodes[a2]; ++k) {
-				const Real area = share(a1, j) * share(a2, k);
+				const Real area = grid.inDomainSupport(a1, j) * grid.inDomainSupport(a2, k); // ∫ N dA over the face
 				if (area == 0) continue;
 				int idx[3];
 				idx[axis] = plane;

@@ -26,6 +26,13 @@ struct GridGeometry {
 	std::size_t         index(int i, int j, int k) const { return static_cast<std::size_t>(i) + nodes[0] * (static_cast<std::size_t>(j) + static_cast<std::size_t>(nodes[1]) * k); }
 	Vec3                nodePosition(int i, int j, int k) const { return origin + cellSize * Vec3(i, j, k); }
 	Vec3                lower() const { return nodePosition(wallNode[0], wallNode[1], wallNode[2]); }
+	// Length along axis d of node i's support inside the domain box, ∫ N_i dx over the box [m]:
+	// h inside, h/2 on a wall plane, 0 beyond the walls.
+	Real inDomainSupport(int d, int i) const
+	{
+		if (i < wallNode[d] || i > upperWallNode[d]) return 0;
+		return i == wallNode[d] || i == upperWallNode[d] ? cellSize / 2 : cellSize;
+	}
 	Vec3                upper() const { return nodePosition(upperWallNode[0], upperWallNode[1], upperWallNode[2]); }
 };
 

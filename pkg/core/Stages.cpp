@@ -399,9 +399,6 @@ namespace stages {
 
 	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, WaterPointSet& P)
 	{
-		// full in-domain support volume of a node: h per axis inside the box, h/2 on a wall plane
-		const Real h      = grid.cellSize;
-		auto       full   = [&](int d, int i) { return i < grid.wallNode[d] || i > grid.upperWallNode[d] ? 0.0 : (i == grid.wallNode[d] || i == grid.upperWallNode[d] ? h / 2 : h); };
 		const std::size_t count = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
@@ -415,7 +412,7 @@ namespace stages {
 						const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
 						if (N <= 0) continue;
 						const int  i = w[0].first + a, j = w[1].first + b, k = w[2].first + c;
-						const Real expected = full(0, i) * full(1, j) * full(2, k);
+						const Real expected = grid.inDomainSupport(0, i) * grid.inDomainSupport(1, j) * grid.inDomainSupport(2, k); // full support volume
 						filling += N * (expected > 0 ? fields.water[grid.index(i, j, k)].volume / expected : 1.0);
 					}
 			const bool surface = filling < threshold;
