@@ -10,6 +10,7 @@
 #include "PointSets.hpp"
 #include "ShapeFunctions.hpp"
 
+#include <string>
 #include <vector>
 
 namespace mpm {
@@ -23,9 +24,21 @@ enum class DragScheme {
 struct SolidSet {
 	SolidPointSet*     points;
 	SoilParameters     soil;
-	bool               kozenyCarman = false;                        // κ(n) by the Kozeny–Carman ratio (theory.md eq. 1.7)
-	SkeletonModel      model        = SkeletonModel::LinearElastic; // constitutive stage (theory.md §7)
-	StrengthParameters strength {};                                 // used by the plastic models
+	bool               kozenyCarman; // κ(n) by the Kozeny–Carman ratio (theory.md eq. 1.7)
+	SkeletonModel      model;        // constitutive stage (theory.md §7)
+	StrengthParameters strength;     // used by the plastic models
+	std::string        name;         // how messages name the set (e.g. its body)
+
+	SolidSet(SolidPointSet* pointSet, const SoilParameters& soilParameters, bool kozenyCarmanPermeability = false,
+	         SkeletonModel skeletonModel = SkeletonModel::LinearElastic, const StrengthParameters& strengthParameters = {}, std::string setName = {})
+	        : points(pointSet)
+	        , soil(soilParameters)
+	        , kozenyCarman(kozenyCarmanPermeability)
+	        , model(skeletonModel)
+	        , strength(strengthParameters)
+	        , name(std::move(setName))
+	{
+	}
 };
 
 // Thread-private copies of the nodal arrays for race-free scatter (one per extra thread).

@@ -71,18 +71,20 @@ TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& setti
 	constrained_ = ConstrainedNodes::build(grid_, domain.boundaries);
 }
 
-void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPointSet*> waters, const WaterParameters& water)
+void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPointSet*> waters, const WaterParameters& water,
+                               const std::vector<std::string>& waterNames)
 {
 	water.validate();
 	Real minSolid = inf, minWater = inf;
 	for (std::size_t s = 0; s < solids.size(); ++s) {
 		solids[s].soil.validate();
 		if (solids[s].model != SkeletonModel::LinearElastic) solids[s].strength.validate();
-		solids[s].points->validate("solid set " + std::to_string(s));
+		if (solids[s].name.empty()) solids[s].name = "solid set " + std::to_string(s);
+		solids[s].points->validate(solids[s].name);
 		minSolid = smallestMass(*solids[s].points, minSolid);
 	}
 	for (std::size_t w = 0; w < waters.size(); ++w) {
-		waters[w]->validate("water set " + std::to_string(w));
+		waters[w]->validate(w < waterNames.size() ? waterNames[w] : "water set " + std::to_string(w));
 		minWater = smallestMass(*waters[w], minWater);
 	}
 	solids_ = std::move(solids);
@@ -132,7 +134,8 @@ TimeStepLimits TwoPhaseSolver::timeStepLimits() const
 long TwoPhaseSolver::advance(Real dt)
 {
 	requireOpenRange("dt", dt, 0, inf, "s");
-	const Real allowed = settings_.timeStepFactor * timeStepLimits().critical;
+	lastLimits_        = timeStepLimits();
+	const Real allowed = settings_.timeStepFactor * lastLimits_.critical;
 	const long substeps = std::isfinite(allowed) ? std::max<long>(1, static_cast<long>(std::ceil(dt / allowed * (1 - 1e-12)))) : 1;
 	for (long i = 0; i < substeps; ++i) step(dt / substeps);
 	return substeps;
@@ -272,6 +275,7 @@ void TwoPhaseSolver::throwIfOutsideGrid() const
 		throw InstabilityError(msg.str());
 	};
 	for (std::size_t s = 0; s < solids_.size(); ++s) check(*solids_[s].points, "solid", s);
+	if (domain_.removeWaterLeavingGrid) return; // removeOutflowingWater has taken those already
 	for (std::size_t w = 0; w < waters_.size(); ++w) check(*waters_[w], "water", w);
 }
 

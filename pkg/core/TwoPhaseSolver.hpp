@@ -63,15 +63,19 @@ class TwoPhaseSolver {
 public:
 	TwoPhaseSolver(const Domain& domain, const SolverSettings& settings);
 
-	// The sets advanced by step() (not owned). Validates the sets and the parameters.
-	void setPoints(std::vector<SolidSet> solids, std::vector<WaterPointSet*> waters, const WaterParameters& water);
+	// The sets advanced by step() (not owned). Validates the sets and the parameters; messages name
+	// a set by SolidSet::name or `waterNames[i]` (default "solid set i" / "water set i").
+	void setPoints(std::vector<SolidSet> solids, std::vector<WaterPointSet*> waters, const WaterParameters& water,
+	               const std::vector<std::string>& waterNames = {});
 
 	TimeStepLimits timeStepLimits() const;
 	// One explicit step of size dt (no sub-stepping). Throws InstabilityError naming the step,
 	// the point and the quantity if the state stops being finite or a point leaves the grid.
 	void step(Real dt);
 	// Advance by dt in equal sub-steps no larger than timeStepFactor × critical; returns their number.
-	long advance(Real dt);
+	// The limits it used are kept in lastTimeStepLimits().
+	long                  advance(Real dt);
+	const TimeStepLimits& lastTimeStepLimits() const { return lastLimits_; }
 
 	long                                                stepCount() const { return steps_; }
 	Real                                                removedWaterMass() const { return removedWaterMass_; } // total, all sets [kg]
@@ -100,6 +104,7 @@ private:
 	long                          steps_              = 0;
 	bool                          waterFieldsZero_    = false; // the water nodal arrays hold zeros (dry steps skip them)
 	Real                          removedWaterMass_   = 0;     // water mass removed by sinks and at the grid's edge [kg]
+	TimeStepLimits                lastLimits_ {};
 	void                          removeOutflowingWater();
 	std::vector<char>             removeFlags_;
 	std::array<double, static_cast<int>(Stage::Count)> stageSeconds_ {};

@@ -18,13 +18,9 @@ using Vec3   = Eigen::Matrix<Real, 3, 1>;
 using Mat3   = Eigen::Matrix<Real, 3, 3>;
 using Voigt6 = Eigen::Matrix<Real, 6, 1>; // (xx, yy, zz, xy, yz, zx)
 
-enum class Phase { Solid, Water };
-
 // Loops over fewer items than this run on one thread: below it OpenMP's fork/join costs more
 // than the work.
 constexpr std::size_t parallelThreshold = 4096;
-
-enum class VoigtIndex : int { XX = 0, YY = 1, ZZ = 2, XY = 3, YZ = 4, ZX = 5 };
 
 inline Mat3 voigtToMatrix(const Voigt6& s)
 {

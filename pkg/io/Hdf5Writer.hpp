@@ -39,7 +39,6 @@ public:
 	// Append one record. Throws std::runtime_error naming the set, field and row of a non-finite
 	// value, or the HDF5 failure.
 	void write(long iteration, double time, const std::vector<PointSetSnapshot>& sets, const GridSnapshot* grid);
-	const std::string& xdmfPath() const { return xdmfPath_; }
 
 private:
 	struct RecordIndex {

@@ -97,6 +97,7 @@ void MpmTwoPhaseEngine::action()
 
 	std::vector<mpm::SolidSet>       solids;
 	std::vector<mpm::WaterPointSet*> waters;
+	std::vector<std::string>         waterNames;
 	mpm::WaterParameters             water;
 	bool                             haveWater = false;
 	long                             solid = 0, fluid = 0;
@@ -107,24 +108,23 @@ void MpmTwoPhaseEngine::action()
 		if (auto* s = dynamic_cast<MpmSolidPoints*>(shape.get())) {
 			auto* mat = dynamic_cast<MpmSoilMat*>(yade::abi::materialOf(body.get()).get());
 			if (!mat) throw mpm::InvalidParameter(where + " carries MpmSolidPoints but its material is not an MpmSoilMat");
-			s->points.validate(where + ".shape");
-			solids.push_back(mpm::SolidSet { &s->points, mat->parameters(), mat->kozenyCarman, mat->skeletonModel(), mat->strength() });
+			solids.push_back(mpm::SolidSet { &s->points, mat->parameters(), mat->kozenyCarman, mat->skeletonModel(), mat->strength(), where + ".shape" });
 			solid += static_cast<long>(s->points.size());
 		} else if (auto* w = dynamic_cast<MpmWaterPoints*>(shape.get())) {
 			auto* mat = dynamic_cast<MpmWaterMat*>(yade::abi::materialOf(body.get()).get());
 			if (!mat) throw mpm::InvalidParameter(where + " carries MpmWaterPoints but its material is not an MpmWaterMat");
-			w->points.validate(where + ".shape");
 			const mpm::WaterParameters params = mat->parameters();
 			if (haveWater && !sameWater(params, water)) throw mpm::InvalidParameter(where + ": all water bodies must share one pore-water material (density, bulkModulus, viscosity)");
 			water     = params;
 			haveWater = true;
 			waters.push_back(&w->points);
+			waterNames.push_back(where + ".shape");
 			fluid += static_cast<long>(w->points.size());
 		}
 	}
-	solver_->setPoints(std::move(solids), std::move(waters), water);
-	criticalTimeStep = solver_->timeStepLimits().critical;
+	solver_->setPoints(std::move(solids), std::move(waters), water, waterNames); // validates every point set
 	subStepsLast     = solver_->advance(dt);
+	criticalTimeStep = solver_->lastTimeStepLimits().critical;
 	solverSteps      = solver_->stepCount();
 	removedWaterMass = removedBefore_ + solver_->removedWaterMass();
 	solidPointCount  = solid;

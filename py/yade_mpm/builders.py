@@ -61,8 +61,8 @@ def saturated_block(lower, upper, cell_size, soil, water, points_per_cell=2, gra
     if geostatic and g > 0:
         rho_w = water.density
         rho_sat = (1 - n0) * soil.density + n0 * rho_w
-        # hydrostatic pore pressure below the water table; the skeleton carries the buoyant weight
-        # below it and the saturated weight above it is not modelled (full saturation)
+        # hydrostatic pore pressure below the water table and none above it (the model is fully
+        # saturated: no suction); the skeleton carries the total weight less the pore pressure
         pore_pressure = rho_w * g * np.clip(z_water - z, 0, None)
         vertical = -(rho_sat * g * (z_top - z) - pore_pressure)
         k0 = soil.poissonRatio / (1 - soil.poissonRatio) if lateral_earth_pressure is None else float(lateral_earth_pressure)
