@@ -32,6 +32,16 @@ struct WallConditions {
 	// Elevation of a free water surface [m] adding the hydrostatic part ρw |g| max(0, waterTable − z)
 	// to p̄ (z: elevation against gravity); the default −∞ adds nothing.
 	Real waterTable = -std::numeric_limits<Real>::infinity();
+	// Drained faces only: water flowing in through the face is supplied as new water points
+	// (theory.md §2.5); without it the face holds p̄ but no water enters.
+	bool inflow = false;
+
+	// Whether x lies below the water table (always, without a table or without gravity).
+	bool belowWaterTable(const Vec3& x, const Vec3& gravity) const
+	{
+		const Real g = gravity.norm();
+		return g == 0 || waterTable == -std::numeric_limits<Real>::infinity() || -gravity.dot(x) / g < waterTable;
+	}
 
 	// p̄ at position x (theory.md eq. 2.1)
 	Real drainedPressureAt(const Vec3& x, const Vec3& gravity, Real waterDensity) const

@@ -139,4 +139,19 @@ Real WaterPointSet::removeWhere(const std::vector<char>& remove)
 	return removed;
 }
 
+std::size_t WaterPointSet::appendCopyOf(std::size_t p)
+{
+	// copy first: push_back of an element of the same vector may reallocate before it reads
+	const Vec3 x = position[p], v = velocity[p], l = halfLength[p];
+	const Real m = mass[p], vol = volume[p], pressure = porePressure[p], n = porosity[p];
+	position.push_back(x);
+	velocity.push_back(v);
+	mass.push_back(m);
+	volume.push_back(vol);
+	halfLength.push_back(l);
+	porePressure.push_back(pressure);
+	porosity.push_back(n);
+	return size() - 1;
+}
+
 } // namespace mpm

@@ -50,6 +50,8 @@ struct WaterPointSet : MaterialPointSet {
 	// Remove the points whose `remove` flag is set, keeping the order of the others; returns the
 	// mass removed [kg].
 	Real removeWhere(const std::vector<char>& remove);
+	// Append a copy of point p (all fields); returns the new point's index.
+	std::size_t appendCopyOf(std::size_t p);
 };
 
 } // namespace mpm

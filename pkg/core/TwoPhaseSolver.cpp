@@ -67,6 +67,9 @@ TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& setti
         , grid_(GridGeometry::forDomain(domain.lower, domain.upper, domain.cellSize))
 {
 	settings_.validate();
+	for (int f = 0; f < faceCount; ++f)
+		if (domain_.boundaries.walls[f].inflow && domain_.boundaries.walls[f].water != WaterWall::Drained)
+			throw InvalidParameter("the inflow face " + std::to_string(f) + " (0..5 = xMin..zMax) must be a drained water wall");
 	fields_.resize(grid_.nodeCount());
 	constrained_ = ConstrainedNodes::build(grid_, domain.boundaries);
 }
@@ -197,6 +200,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 			      *waters_[w]);
 	}
 	removeOutflowingWater();
+	injectInflowingWater();
 	throwIfOutsideGrid();
 	{
 		StageTimer                           t(stageSeconds_, Stage::RemapVelocities);
@@ -259,6 +263,66 @@ void TwoPhaseSolver::removeOutflowingWater()
 			any             = any || out;
 		}
 		if (any) removedWaterMass_ += w->removeWhere(removeFlags_);
+	}
+}
+
+void TwoPhaseSolver::updateDrainedValues(const BoundaryConditions& boundaries)
+{
+	for (int f = 0; f < faceCount; ++f) {
+		domain_.boundaries.walls[f].drainedPressure = boundaries.walls[f].drainedPressure;
+		domain_.boundaries.walls[f].waterTable      = boundaries.walls[f].waterTable;
+	}
+}
+
+// Water entering through an inflow face (theory.md eq. 2.5). The face is tiled in rows one point
+// spacing s = 2 l_p wide (l_p of the set's first point: lattice sets tile the face exactly). A
+// row whose outermost water point has moved to 1.5 s or more inside the face has room for one
+// more: a copy of that point is placed s closer to the face (so its domain ends at or inside the
+// face), below the water table only, with the face's p̄. Rows with no water point within 2.5 s of
+// the face are not refilled (there is no water there to draw on). The injected mass is accounted
+// in injectedWaterMass.
+void TwoPhaseSolver::injectInflowingWater()
+{
+	const Vec3 lower = grid_.lower(), upper = grid_.upper();
+	for (int face = 0; face < faceCount; ++face) {
+		const WallConditions& wall = domain_.boundaries.walls[face];
+		if (!wall.inflow) continue;
+		const int  axis = face / 2, a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+		const bool upperFace = face % 2 == 1;
+		const Real inward    = upperFace ? -1 : 1;
+		const Real plane     = upperFace ? upper[axis] : lower[axis];
+		for (WaterPointSet* w : waters_) {
+			if (w->size() == 0) continue;
+			const Vec3 spacing = 2 * w->halfLength[0];
+			if (!(spacing.minCoeff() > 0)) continue; // zero-size points do not tile the face
+			const long rows1 = static_cast<long>(std::ceil((upper[a1] - lower[a1]) / spacing[a1]));
+			const long rows2 = static_cast<long>(std::ceil((upper[a2] - lower[a2]) / spacing[a2]));
+			inflowNearest_.assign(rows1 * rows2, -1);
+			inflowDepth_.assign(rows1 * rows2, inf);
+			for (std::size_t p = 0; p < w->size(); ++p) {
+				const Vec3& x     = w->position[p];
+				const Real  depth = inward * (x[axis] - plane);
+				if (!(depth >= 0 && depth < 2.5 * spacing[axis])) continue;
+				const long r1 = static_cast<long>(std::floor((x[a1] - lower[a1]) / spacing[a1]));
+				const long r2 = static_cast<long>(std::floor((x[a2] - lower[a2]) / spacing[a2]));
+				if (r1 < 0 || r1 >= rows1 || r2 < 0 || r2 >= rows2) continue;
+				const long row = r1 * rows2 + r2;
+				if (depth < inflowDepth_[row]) {
+					inflowDepth_[row]   = depth;
+					inflowNearest_[row] = static_cast<long>(p);
+				}
+			}
+			for (std::size_t row = 0; row < inflowNearest_.size(); ++row) {
+				if (inflowNearest_[row] < 0 || inflowDepth_[row] < 1.5 * spacing[axis]) continue;
+				Vec3 x = w->position[inflowNearest_[row]];
+				x[axis] -= inward * spacing[axis];
+				if (!wall.belowWaterTable(x, settings_.gravity)) continue;
+				const std::size_t q = w->appendCopyOf(static_cast<std::size_t>(inflowNearest_[row]));
+				w->position[q]      = x;
+				w->porePressure[q]  = wall.drainedPressureAt(x, settings_.gravity, water_.density);
+				injectedWaterMass_ += w->mass[q];
+			}
+		}
 	}
 }
 

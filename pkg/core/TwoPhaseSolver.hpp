@@ -79,6 +79,10 @@ public:
 
 	long                                                stepCount() const { return steps_; }
 	Real                                                removedWaterMass() const { return removedWaterMass_; } // total, all sets [kg]
+	Real                                                injectedWaterMass() const { return injectedWaterMass_; } // through inflow faces [kg]
+	// Replace the values held on drained faces (p̄ and water table, e.g. a rising head) without
+	// rebuilding the solver; the kinds of the walls must stay as they were built.
+	void updateDrainedValues(const BoundaryConditions& boundaries);
 	const std::array<double, static_cast<int>(Stage::Count)>& stageSeconds() const { return stageSeconds_; }
 	const GridGeometry&                                 grid() const { return grid_; }
 	const GridFields&                                   fields() const { return fields_; }
@@ -104,6 +108,10 @@ private:
 	long                          steps_              = 0;
 	bool                          waterFieldsZero_    = false; // the water nodal arrays hold zeros (dry steps skip them)
 	Real                          removedWaterMass_   = 0;     // water mass removed by sinks and at the grid's edge [kg]
+	Real                          injectedWaterMass_  = 0;     // water mass supplied through inflow faces [kg]
+	void                          injectInflowingWater();
+	std::vector<long>             inflowNearest_;
+	std::vector<Real>             inflowDepth_;
 	TimeStepLimits                lastLimits_ {};
 	void                          removeOutflowingWater();
 	std::vector<char>             removeFlags_;

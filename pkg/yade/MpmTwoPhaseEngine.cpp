@@ -60,6 +60,10 @@ mpm::Domain MpmTwoPhaseEngine::domain() const
 		wall.water           = parseOption("waterWalls[" + std::string(faceNames[f]) + "]", waterWalls[f], waterWallOptions);
 		wall.drainedPressure = drainedPressure[f];
 		wall.waterTable      = drainedWaterTable[f];
+		wall.inflow          = waterInflow[f] != 0;
+		if (wall.inflow && wall.water != mpm::WaterWall::Drained)
+			throw mpm::InvalidParameter("waterInflow[" + std::string(faceNames[f]) + "] is set but waterWalls[" + faceNames[f] + "] = '" + waterWalls[f] +
+			                            "': inflow needs a 'drained' face");
 		if (!(wall.waterTable < std::numeric_limits<yade::Real>::infinity()))
 			mpm::throwOutOfRange("drainedWaterTable[" + std::string(faceNames[f]) + "]", wall.waterTable, "m", "[-inf (none), inf)");
 		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + std::string(faceNames[f]) + "]", wall.drainedPressure, "Pa", "finite values");
@@ -93,7 +97,10 @@ mpm::SolverSettings MpmTwoPhaseEngine::settings() const
 void MpmTwoPhaseEngine::action()
 {
 	const yade::Real dt = yade::abi::dt(scene);
-	if (!solver_) solver_ = std::make_unique<mpm::TwoPhaseSolver>(domain(), settings());
+	if (!solver_) {
+		solver_   = std::make_unique<mpm::TwoPhaseSolver>(domain(), settings());
+		builtFor_ = structure();
+	}
 
 	std::vector<mpm::SolidSet>       solids;
 	std::vector<mpm::WaterPointSet*> waters;
@@ -127,6 +134,7 @@ void MpmTwoPhaseEngine::action()
 	criticalTimeStep = solver_->lastTimeStepLimits().critical;
 	solverSteps      = solver_->stepCount();
 	removedWaterMass = removedBefore_ + solver_->removedWaterMass();
+	injectedWaterMass = injectedBefore_ + solver_->injectedWaterMass();
 	solidPointCount  = solid;
 	waterPointCount  = fluid;
 	lastDt           = dt;
@@ -135,17 +143,30 @@ void MpmTwoPhaseEngine::action()
 	++stepsDone;
 }
 
+MpmTwoPhaseEngine::Structure MpmTwoPhaseEngine::structure() const
+{
+	return Structure { gravity,       timeStepFactor, flipBlend,  domainMin,  domainMax,  cellSize,               shapeFunction, drag,
+		           cellAveraging, freeSurfaceThreshold, solidWalls, waterWalls, waterSinks, removeWaterLeavingGrid, waterInflow };
+}
+
 void MpmTwoPhaseEngine::callPostLoad()
 {
 	yade::GlobalEngine::callPostLoad();
-	if (solver_) removedBefore_ += solver_->removedWaterMass(); // keep the total across rebuilds
-	solver_.reset(); // any change of the set-up rebuilds the grid and the constraints
 	try {
 		settings();
-		domain();
+		const mpm::Domain d = domain();
+		if (solver_ && structure() == builtFor_) { // only drained values changed: keep the solver
+			solver_->updateDrainedValues(d.boundaries);
+			return;
+		}
 	} catch (const mpm::InvalidParameter& e) {
 		raisePython(PyExc_ValueError, "MpmTwoPhaseEngine: " + std::string(e.what()));
 	}
+	if (solver_) { // keep the totals across rebuilds
+		removedBefore_ += solver_->removedWaterMass();
+		injectedBefore_ += solver_->injectedWaterMass();
+	}
+	solver_.reset(); // any other change of the set-up rebuilds the grid and the constraints
 }
 
 const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
@@ -184,6 +205,22 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		boolAttr("removeWaterLeavingGrid", &E::removeWaterLeavingGrid, "Remove water points that leave the grid and count their mass in removedWaterMass (else the run stops) [-]"),
 		fixedListAttr("drainedWaterTable", &E::drainedWaterTable, 6,
 		              "Per 'drained' face, the elevation of a free water surface [m] adding the hydrostatic part ρw |g| max(0, table − z) to p̄ (z measured against gravity); -inf: none"),
+		AttrSpec<E> { "waterInflow", "Per face (xMin..zMax), whether water drawn in through that 'drained' face is supplied as new water points (theory.md eq. 2.5) [-]",
+		              [](const E& e) {
+			              py::list l;
+			              for (int on : e.waterInflow) l.append(on != 0);
+			              return py::object(py::tuple(l));
+		              },
+		              [](E& e, const py::object& v) {
+			              if (py::len(v) != 6) raisePython(PyExc_ValueError, "attribute 'waterInflow' expects 6 entries (xMin, xMax, yMin, yMax, zMin, zMax)");
+			              std::vector<int> on;
+			              for (long i = 0; i < 6; ++i) {
+				              py::extract<bool> b(v[i]);
+				              if (!b.check()) raisePython(PyExc_TypeError, "attribute 'waterInflow' has a non-boolean entry at index " + std::to_string(i));
+				              on.push_back(b() ? 1 : 0);
+			              }
+			              e.waterInflow = on;
+		              } },
 		readOnly(intAttr("stepsDone", &E::stepsDone, "Number of times the engine ran [-]")),
 		readOnly(realAttr("mpmTime", &E::mpmTime, "Total time the MPM state was advanced [s]")),
 		readOnly(intAttr("lastIter", &E::lastIter, "O.iter seen by the last run of the engine [-]")),
@@ -193,6 +230,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		readOnly(intAttr("subStepsLast", &E::subStepsLast, "Explicit sub-steps taken by the last run [-]")),
 		readOnly(intAttr("solverSteps", &E::solverSteps, "Explicit steps since the solver was (re)built [-]")),
 		readOnly(realAttr("removedWaterMass", &E::removedWaterMass, "Water mass removed by waterSinks and at the grid's edge since the start [kg]")),
+		readOnly(realAttr("injectedWaterMass", &E::injectedWaterMass, "Water mass supplied as new water points through waterInflow faces since the start [kg]")),
 		readOnly(realAttr("criticalTimeStep", &E::criticalTimeStep,
 		                  "Critical time step of the last run before timeStepFactor: min of the wave limit h/(fastest wave + fastest point) and, with explicit drag, the drag limit [s]")),
 	};
@@ -224,8 +262,13 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& BOOST_SERIALIZATION_NVP(drainedWaterTable);
 	serializeFlat(ar, "waterSinks", waterSinks);
 	ar& BOOST_SERIALIZATION_NVP(removeWaterLeavingGrid);
+	ar& BOOST_SERIALIZATION_NVP(waterInflow);
 	ar& BOOST_SERIALIZATION_NVP(removedWaterMass);
-	if (Archive::is_loading::value) removedBefore_ = removedWaterMass;
+	ar& BOOST_SERIALIZATION_NVP(injectedWaterMass);
+	if (Archive::is_loading::value) {
+		removedBefore_  = removedWaterMass;
+		injectedBefore_ = injectedWaterMass;
+	}
 	ar& BOOST_SERIALIZATION_NVP(stepsDone);
 	ar& BOOST_SERIALIZATION_NVP(mpmTime);
 	ar& BOOST_SERIALIZATION_NVP(lastIter);

@@ -10,6 +10,7 @@
 
 #include <limits>
 #include <memory>
+#include <tuple>
 
 namespace yade_mpm {
 
@@ -32,6 +33,7 @@ public:
 	std::vector<yade::Vector3r> waterSinks;             // (lower, upper) corner pairs of sink boxes [m]
 	bool                        removeWaterLeavingGrid = true; // water leaving the grid is removed (else: stop)
 	std::vector<yade::Real>  drainedWaterTable = std::vector<yade::Real>(6, -std::numeric_limits<yade::Real>::infinity()); // [m], -inf: none
+	std::vector<int>         waterInflow = std::vector<int>(6, 0); // per face: water points enter through this drained face
 
 	// outputs (read-only from Python)
 	long       stepsDone       = 0; // number of times action() ran [-]
@@ -44,6 +46,7 @@ public:
 	long       solverSteps     = 0;  // explicit steps since the solver was set up [-]
 	yade::Real criticalTimeStep = 0; // critical step of the last action(), before timeStepFactor [s]
 	yade::Real removedWaterMass = 0; // water mass removed by sinks and at the grid's edge, in total [kg]
+	yade::Real injectedWaterMass = 0; // water mass supplied through inflow faces, in total [kg]
 
 	MpmTwoPhaseEngine() = default;
 	~MpmTwoPhaseEngine() override;
@@ -59,8 +62,16 @@ public:
 	const mpm::TwoPhaseSolver* solver() const { return solver_.get(); }
 
 private:
+	// Everything the solver is built from except the values held on drained faces, which a
+	// running solver takes over in place (a rising head set every step must not rebuild it).
+	using Structure = std::tuple<yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, yade::Real,
+	                             std::vector<std::string>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, std::vector<int>>;
+	Structure structure() const;
+
 	std::unique_ptr<mpm::TwoPhaseSolver> solver_;  // not serialized: rebuilt on first action()
-	yade::Real                           removedBefore_ = 0; // removed by solvers before the current one [kg]
+	Structure                            builtFor_ {};
+	yade::Real                           removedBefore_  = 0; // removed by solvers before the current one [kg]
+	yade::Real                           injectedBefore_ = 0; // injected by solvers before the current one [kg]
 };
 
 } // namespace yade_mpm

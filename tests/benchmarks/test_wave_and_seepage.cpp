@@ -308,3 +308,56 @@ TEST(FreeSurface, DetectsTheOuterLayerOfAColumnBelowTheDomainTop)
 }
 
 } // namespace
+
+namespace {
+
+// Inflow (theory.md eq. 2.5): upward seepage at 0.8 i_c through a column whose drained base is an
+// inflow face and whose drained top lets the water leave into a sink. In the steady state the base
+// supplies the Darcy flux q = k i as new water points, the water leaving the top is removed, and
+// the water mass balance closes to round-off.
+TEST(Inflow, SuppliesTheDarcyFluxAndClosesTheWaterMassBalance)
+{
+	const double g = 9.81, H = 0.5, h = 0.05, k = 0.05;
+	Column       c(H, h, k, g);
+	c.water.bulkModulus = 2.2e7; // Kw/n = 10 E_oed: the steady flux does not depend on Kw
+	const double gammaW = c.water.density * g, iCritical = (c.rhoSat() - c.water.density) / c.water.density, i = 0.8 * iCritical;
+	fixtures::setGeostatic(c.solid, c.fluid, c.soil, c.water, g, H);
+	c.domain.boundaries.walls[static_cast<int>(Face::ZMin)]        = { SolidWall::Fixed, WaterWall::Drained, gammaW * (H + i * H) };
+	c.domain.boundaries.walls[static_cast<int>(Face::ZMin)].inflow = true;
+	c.domain.boundaries.walls[static_cast<int>(Face::ZMax)]        = { SolidWall::Free, WaterWall::Drained, 0.0 };
+	c.domain.sinks.push_back({ Vec3(-1, -1, H), Vec3(1, 1, 2 * H) }); // water leaving the top is taken away
+	c.start();
+	double initial = 0;
+	for (double m : c.fluid.mass) initial += m;
+	const double layerMass = 4 * c.fluid.mass[0]; // 2 × 2 points per layer of the one-cell column
+	const double cv = analytical::consolidationCoefficient(c.soil.intrinsicPermeability / c.water.viscosity, c.soil.constrainedModulus(),
+	                                                       c.soil.porosity, c.water.bulkModulus);
+	c.run(2.5 * H * H / cv); // steady seepage
+	const double injected0 = c.solver->injectedWaterMass(), removed0 = c.solver->removedWaterMass();
+	const double duration  = 2.5; // the pore water rises q/n × 2.5 s = 0.25 m, ten point layers
+	for (int part = 0; part < 25; ++part) {
+		c.run(duration / 25);
+		if (!getenv("MPM_PROFILE")) continue;
+		double vs = 0, vw = 0, top = 0;
+		for (std::size_t p = 0; p < c.solid.size(); ++p) { vs += c.solid.velocity[p].z() / c.solid.size(); top = std::max(top, c.solid.position[p].z()); }
+		for (std::size_t p = 0; p < c.fluid.size(); ++p) vw += c.fluid.velocity[p].z() / c.fluid.size();
+		std::printf("  t+%.1f: %zu water points, mean vs %.3e vw %.3e, solid top %.4f, injected %.3e removed %.3e\n", (part + 1) * duration / 25, c.fluid.size(), vs, vw, top,
+		            c.solver->injectedWaterMass() - injected0, c.solver->removedWaterMass() - removed0);
+	}
+	double stored = 0;
+	for (double m : c.fluid.mass) stored += m;
+	const double injected = c.solver->injectedWaterMass() - injected0, removed = c.solver->removedWaterMass() - removed0;
+	const double expected = c.water.density * k * i * h * h * duration;
+	std::printf("inflow: injected %.4e kg, removed %.4e kg, Darcy %.4e kg over %.1f s (one layer %.2e kg); balance residual %.1e\n", injected,
+	            removed, expected, duration, layerMass, (stored + c.solver->removedWaterMass() - initial - c.solver->injectedWaterMass()) / initial);
+	EXPECT_NEAR(stored + c.solver->removedWaterMass(), initial + c.solver->injectedWaterMass(), 1e-12 * initial);
+	// points enter whole: the supply over a window is the Darcy mass to within one point layer
+	EXPECT_NEAR(injected, expected, layerMass + 0.02 * expected);
+	EXPECT_NEAR(removed, expected, layerMass + 0.02 * expected);
+	// the water lattice near the inflow face stays as dense as it started: 2 point layers within 2s
+	int nearBase = 0;
+	for (const Vec3& x : c.fluid.position) nearBase += x.z() < h;
+	EXPECT_NEAR(nearBase, 8, 4);
+}
+
+} // namespace
