@@ -242,11 +242,12 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	}
 }
 
-// Water points in a sink, or (when allowed) leaving the grid, leave the model; their mass is
+// Water points in a sink, free water (when asked: it has left the soil, as into a filtering
+// cloth) or (when allowed) water leaving the grid leave the model; their mass is
 // accounted in removedWaterMass (theory.md §2.4). Their nodal mass of this step is already spent.
 void TwoPhaseSolver::removeOutflowingWater()
 {
-	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid) return;
+	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid && !domain_.removeFreeWater) return;
 	for (WaterPointSet* w : waters_) {
 		const std::size_t n = w->size();
 		removeFlags_.assign(n, 0);
@@ -254,6 +255,8 @@ void TwoPhaseSolver::removeOutflowingWater()
 		for (std::size_t p = 0; p < n; ++p) {
 			bool out = false;
 			for (const WaterSink& sink : domain_.sinks) out = out || sink.contains(w->position[p]);
+			// n = 1 exactly when no node of the point's stencil carries solid (eq. 4.5, this step)
+			out = out || (domain_.removeFreeWater && w->porosity[p] >= 1);
 			if (!out && domain_.removeWaterLeavingGrid)
 				for (int d = 0; d < 3; ++d) { // the widest (GIMP) stencil must fit in the grid
 					const Real u = (w->position[p][d] - grid_.origin[d]) / grid_.cellSize;

@@ -69,6 +69,7 @@ mpm::Domain MpmTwoPhaseEngine::domain() const
 		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + std::string(faceNames[f]) + "]", wall.drainedPressure, "Pa", "finite values");
 	}
 	d.removeWaterLeavingGrid = removeWaterLeavingGrid;
+	d.removeFreeWater        = removeFreeWater;
 	if (waterSinks.size() % 2) throw mpm::InvalidParameter("waterSinks must hold (lower, upper) corner pairs; it has " + std::to_string(waterSinks.size()) + " corners");
 	for (std::size_t i = 0; i + 1 < waterSinks.size(); i += 2) {
 		if (!(waterSinks[i].array() <= waterSinks[i + 1].array()).all() || !waterSinks[i].allFinite() || !waterSinks[i + 1].allFinite())
@@ -146,7 +147,7 @@ void MpmTwoPhaseEngine::action()
 MpmTwoPhaseEngine::Structure MpmTwoPhaseEngine::structure() const
 {
 	return Structure { gravity,       timeStepFactor, flipBlend,  domainMin,  domainMax,  cellSize,               shapeFunction, drag,
-		           cellAveraging, freeSurfaceThreshold, solidWalls, waterWalls, waterSinks, removeWaterLeavingGrid, waterInflow };
+		           cellAveraging, freeSurfaceThreshold, solidWalls, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow };
 }
 
 void MpmTwoPhaseEngine::callPostLoad()
@@ -202,6 +203,8 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 			              }
 			              e.waterSinks = corners;
 		              } },
+		boolAttr("removeFreeWater", &E::removeFreeWater,
+		         "Remove water points that have left the soil (no solid in their stencil, n = 1), e.g. seepage caught by a filtering cloth; their mass counts in removedWaterMass [-]"),
 		boolAttr("removeWaterLeavingGrid", &E::removeWaterLeavingGrid, "Remove water points that leave the grid and count their mass in removedWaterMass (else the run stops) [-]"),
 		fixedListAttr("drainedWaterTable", &E::drainedWaterTable, 6,
 		              "Per 'drained' face, the elevation of a free water surface [m] adding the hydrostatic part ρw |g| max(0, table − z) to p̄ (z measured against gravity); -inf: none"),
@@ -262,6 +265,7 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& BOOST_SERIALIZATION_NVP(drainedWaterTable);
 	serializeFlat(ar, "waterSinks", waterSinks);
 	ar& BOOST_SERIALIZATION_NVP(removeWaterLeavingGrid);
+	ar& BOOST_SERIALIZATION_NVP(removeFreeWater);
 	ar& BOOST_SERIALIZATION_NVP(waterInflow);
 	ar& BOOST_SERIALIZATION_NVP(removedWaterMass);
 	ar& BOOST_SERIALIZATION_NVP(injectedWaterMass);

@@ -193,3 +193,23 @@ def test_inflow_face_supplies_water_points_under_a_raised_head_and_the_balance_c
     # the column stands below the critical gradient (each injection jolts the skeleton briefly, by
     # up to 1 cm/s here, but it does not move away)
     assert np.abs(solid.pos - start).max() < 1e-3
+
+
+def test_free_water_is_removed_when_asked_and_water_in_soil_is_not():
+    """removeFreeWater (eq. 2.4): water with no solid in its stencil (n = 1) leaves the model, as
+    into a filtering cloth; saturated soil keeps all of its water."""
+    fluid = water_only_block(0.3)
+    initial = fluid.mass.sum()
+    engine = w.MpmTwoPhaseEngine(label="mpm", gravity=G, domainMin=(0, 0, 0), domainMax=(0.1, 0.1, 0.3), cellSize=0.05,
+                                 waterWalls=("impermeable",) * 5 + ("free",), removeFreeWater=True)
+    O.engines = [engine]
+    O.dt = 1e-3
+    O.step()
+    assert fluid.count == 0 and engine.removedWaterMass == pytest.approx(initial, rel=1e-12)
+    O.reset()
+    soil, water, solid, fluid, engine = column(0.5, 0.05)
+    engine.removeFreeWater = True
+    count = fluid.count
+    O.dt = 1e-3
+    O.run(20, True)
+    assert fluid.count == count and engine.removedWaterMass == 0
