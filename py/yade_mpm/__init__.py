@@ -35,8 +35,8 @@ self_test(_yade_mpm, yade.wrapper, yade.wrapper.Omega())
 
 from yade.wrapper import MpmHdf5Recorder, MpmSoilMat, MpmSolidPoints, MpmTwoPhaseEngine, MpmWaterMat, MpmWaterPoints  # noqa: E402
 from . import analytical, builders, results, sandpile  # noqa: E402
-from .builders import saturated_block  # noqa: E402
+from .builders import saturated_block, saturated_points  # noqa: E402
 
 __version__ = _buildinfo.package_version
 __all__ = ["MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat", "MpmHdf5Recorder", "YadeAbiMismatch",
-           "saturated_block"]
+           "saturated_block", "saturated_points"]

@@ -47,6 +47,34 @@ def saturated_block(lower, upper, cell_size, soil, water, points_per_cell=2, gra
     if gravity.shape != (3,) or gravity[0] != 0 or gravity[1] != 0 or gravity[2] > 0:
         raise ValueError("gravity = %r m s⁻² must point along −z (or be zero) for a geostatic start" % (gravity.tolist(),))
     positions, spacing = _lattice(lower, upper, cell_size, points_per_cell)
+    surface = float(upper[2])
+    return saturated_points(positions, spacing, soil, water, gravity=gravity if geostatic else (0.0, 0.0, 0.0),
+                            surface=np.full(len(positions), surface), water_table=surface if water_table is None else water_table,
+                            lateral_earth_pressure=lateral_earth_pressure)
+
+
+def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), surface=None, water_table=None,
+                     lateral_earth_pressure=None, suction_above_table=False):
+    """Solid and water points at the same `positions` (N×3 [m]), each the centre of a cube of side
+    `spacing` [m] (V0 = spacing³, GIMP half-length spacing/2), with porosity soil.porosity.
+
+    With gravity (along −z) and `surface` (N elevations of the ground surface above each point [m]),
+    the start is geostatic as under level ground: hydrostatic pore pressure below `water_table`
+    [m], σ′_zz = −(ρsat g (surface − z) − p), σ′_xx = σ′_yy = K0 σ′_zz with K0 =
+    `lateral_earth_pressure` (default ν/(1−ν)). Above the table p = 0, or with
+    `suction_above_table` the hydrostatic suction p = −ρw g (z − table) of soil held saturated by
+    capillarity (water at rest everywhere). Without gravity the points start stress-free at p = 0.
+
+    Returns (solid_body, water_body), two non-dynamic Bodies to append to O.bodies.
+    """
+    positions = np.asarray(positions, dtype=float)
+    gravity = np.asarray(gravity, dtype=float)
+    if positions.ndim != 2 or positions.shape[1] != 3 or len(positions) == 0:
+        raise ValueError("positions must be a non-empty N×3 array [m], got shape %r" % (positions.shape,))
+    if not spacing > 0:
+        raise ValueError("spacing = %r m is outside the valid range (0, inf)" % (spacing,))
+    if gravity.shape != (3,) or gravity[0] != 0 or gravity[1] != 0 or gravity[2] > 0:
+        raise ValueError("gravity = %r m s⁻² must point along −z (or be zero) for a geostatic start" % (gravity.tolist(),))
     count = len(positions)
     n0 = soil.porosity
     volume = np.full(count, spacing ** 3)
@@ -54,17 +82,20 @@ def saturated_block(lower, upper, cell_size, soil, water, points_per_cell=2, gra
 
     g = -gravity[2]
     z = positions[:, 2]
-    z_top = float(upper[2])
-    z_water = z_top if water_table is None else float(water_table)
     pore_pressure = np.zeros(count)
     stress = np.zeros((count, 3, 3))
-    if geostatic and g > 0:
+    if g > 0:
+        if surface is None or water_table is None:
+            raise ValueError("a geostatic start needs the ground surface and the water table elevations [m]")
+        surface = np.broadcast_to(np.asarray(surface, dtype=float), (count,))
         rho_w = water.density
         rho_sat = (1 - n0) * soil.density + n0 * rho_w
-        # hydrostatic pore pressure below the water table and none above it (the model is fully
-        # saturated: no suction); the skeleton carries the total weight less the pore pressure
-        pore_pressure = rho_w * g * np.clip(z_water - z, 0, None)
-        vertical = -(rho_sat * g * (z_top - z) - pore_pressure)
+        # hydrostatic pore pressure below the water table; above it none, or the capillary suction
+        # that holds the water at rest; the skeleton carries the total weight less the pore pressure
+        pore_pressure = rho_w * g * (float(water_table) - z)
+        if not suction_above_table:
+            pore_pressure = np.clip(pore_pressure, 0, None)
+        vertical = -(rho_sat * g * (surface - z) - pore_pressure)
         k0 = soil.poissonRatio / (1 - soil.poissonRatio) if lateral_earth_pressure is None else float(lateral_earth_pressure)
         stress[:, 0, 0] = stress[:, 1, 1] = k0 * vertical
         stress[:, 2, 2] = vertical

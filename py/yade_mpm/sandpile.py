@@ -11,7 +11,15 @@ the values below are documented lab-scale choices, not the paper's:
   friction softening to 30° over κ_s = 0.05; k = 1e-3 m s⁻¹ (medium sand);
 * water: ρw = 1000 kg m⁻³, μw = 1e-3 Pa s, Kw lowered to 2.2e8 Pa for speed: Kw/n = 20 E_oed keeps
   the water nearly incompressible for this quasi-static seepage (the formulation asks ≥ 10–100);
-* head at the inflow face rising linearly from the crest-free level 0.06 m to 0.14 m over 20 s.
+* the pile starts saturated throughout, at rest: hydrostatic below the inflow level 0.03 m and held
+  by capillary suction above it (the experiment keeps the pile saturated for the same reason);
+* head at the inflow face held at 0.03 m for 0.05 s (the pile settles under gravity), then raised
+  linearly to the crest, 0.12 m, over 0.3 s, then held for 0.2 s. The laboratory raises it over
+  minutes; the ramp here is compressed because the pore pressures follow it quasi-statically
+  either way: they settle in the consolidation time L² γw / (k M) ≈ 0.035 s over the 0.3 m flow
+  path (M = 1/(1/E_oed + n/Kw) ≈ 26 MPa), a ninth of the ramp. What the compression does change
+  is how far the water itself moves: at Darcy speeds of ~1e-3 m/s it moves less than a millimetre
+  in the simulated time, so the pile is seen failing under the pressure field, not under inflow.
 """
 import math
 from dataclasses import dataclass, field
@@ -39,9 +47,11 @@ class SandPileScene:
     water_density: float = 1000.0    # ρw [kg m⁻³]
     water_viscosity: float = 1e-3    # μw [Pa s]
     water_bulk_modulus: float = 2.2e8  # Kw [Pa]
-    head_start: float = 0.06         # inflow water level at t = 0 [m]
-    head_end: float = 0.14           # inflow water level at the end of the ramp [m]
-    head_ramp_time: float = 20.0     # [s]
+    head_start: float = 0.03         # inflow water level while the pile settles [m]
+    head_end: float = 0.12           # inflow water level at the end of the ramp (the crest) [m]
+    settle_time: float = 0.05        # head held at head_start from t = 0 [s]
+    head_ramp_time: float = 0.3      # duration of the linear rise that follows [s]
+    hold_time: float = 0.2           # head held at head_end after the rise [s]
 
     def toe_x(self):
         """x of the downstream toe [m]."""
@@ -54,9 +64,13 @@ class SandPileScene:
         return np.where(x <= self.crest_length, self.pile_height, np.clip(down, 0, None))
 
     def head(self, time):
-        """Inflow water level [m] at time t [s] (linear ramp, then held)."""
-        r = min(max(time / self.head_ramp_time, 0.0), 1.0)
+        """Inflow water level [m] at time t [s]: held while settling, raised linearly, then held."""
+        r = min(max((time - self.settle_time) / self.head_ramp_time, 0.0), 1.0)
         return self.head_start + r * (self.head_end - self.head_start)
+
+    def duration(self):
+        """Settling, rise and hold [s]."""
+        return self.settle_time + self.head_ramp_time + self.hold_time
 
     def intrinsic_permeability(self, gravity):
         """κ = k μw / (ρw |g|) [m²] for the scene's gravity vector [m s⁻²]."""
@@ -67,6 +81,8 @@ class SandPileScene:
             raise ValueError("slope_angle = %r rad is outside the valid range (0, π/2)" % self.slope_angle)
         if self.toe_x() >= self.flume_length:
             raise ValueError("the pile's toe x = %.3f m lies beyond the flume length %.3f m" % (self.toe_x(), self.flume_length))
+        if not (0 <= self.head_start <= self.head_end <= self.pile_height):
+            raise ValueError("heads must satisfy 0 ≤ head_start ≤ head_end ≤ pile_height; got %r, %r, %r m" % (self.head_start, self.head_end, self.pile_height))
         if self.pile_height >= self.flume_height:
             raise ValueError("pile_height = %r m must be below flume_height = %r m" % (self.pile_height, self.flume_height))
 

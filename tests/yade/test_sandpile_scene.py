@@ -20,8 +20,9 @@ def test_pile_geometry_volume_and_points():
 
 def test_head_history_and_permeability():
     s = sandpile.DEFAULT
-    assert s.head(0) == s.head_start and s.head(1e9) == s.head_end
-    assert s.head(s.head_ramp_time / 2) == pytest.approx(0.5 * (s.head_start + s.head_end))
+    assert s.head(0) == s.head(s.settle_time) == s.head_start and s.head(1e9) == s.head_end
+    assert s.head(s.settle_time + s.head_ramp_time / 2) == pytest.approx(0.5 * (s.head_start + s.head_end))
+    assert s.duration() == pytest.approx(s.settle_time + s.head_ramp_time + s.hold_time)
     # k = κ ρw g / μw: 1e-3 m/s back from κ with the gravity given
     kappa = s.intrinsic_permeability((0, 0, -9.81))
     assert kappa * s.water_density * 9.81 / s.water_viscosity == pytest.approx(s.hydraulic_conductivity)

@@ -1,0 +1,293 @@
+"""Saturated sand pile in a flume that fails when the hydraulic head at its inflow face is raised.
+
+Run:  yade-double -n -x examples/sandpile/sandpile.py [--quick] [--out DIR]
+      (or /usr/bin/python3 examples/sandpile/sandpile.py ...)
+
+The scene (flume, pile, sand, water, head history) is yade_mpm.sandpile.DEFAULT, documented there.
+3D: the flume's front and rear walls (y = 0, width) are smooth and impermeable, the base is rough
+and impermeable, the upstream face x = 0 is a drained inflow face held at the hydrostatic profile
+of the rising head H(t) (water enters as new water points), the pile's surface is a free surface
+and seepage face (p = 0), and water that seeps out of the pile is taken by the filtering cloth
+(removed once it has left the soil, its mass counted). Mohr–Coulomb sand with friction softening.
+
+Quick mode: cell h = 2 cm (6 cells over the pile height), a few minutes on 2 cores. Full mode:
+h = 1 cm. Both run the whole head history.
+
+Writes to DIR (default examples/sandpile/out[-quick]):
+  sandpile.h5 + sandpile.xdmf     point fields over time (ParaView)
+  pore_pressure.png               pore pressure at four times (x–z view)
+  velocity_at_failure.png         solid velocity field at failure
+  shear_band.png                  plastic shear strain with the extracted sliding surface
+  time_series.png                 head, pore pressure at probes, toe displacement
+  time_series.csv                 the same numbers
+  summary.json                    failure head and time, sliding surface, mass balance, run time
+The water mass balance (initial + injected = stored + removed) is checked at every record; the run
+stops with an error if it fails to close to 1e-9.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+import yade_mpm
+from yade import O
+from yade_mpm import MpmHdf5Recorder, MpmSoilMat, MpmTwoPhaseEngine, MpmWaterMat, sandpile
+
+parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+parser.add_argument("--quick", action="store_true", help="2 cm cells: a few minutes on 2 cores (the CI test runs this)")
+parser.add_argument("--cell", type=float, help="cell size h [m] (default 0.02 quick, 0.01 full)")
+parser.add_argument("--duration", type=float, help="stop after this time [s] (default: the whole head history)")
+parser.add_argument("--out", help="output directory")
+args = parser.parse_args(sys.argv[1:])
+
+SCENE = sandpile.DEFAULT
+GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
+CELL = args.cell or (0.02 if args.quick else 0.01)  # h [m]
+DURATION = args.duration or SCENE.duration()  # [s]
+OUT = args.out or os.path.join(os.path.dirname(os.path.abspath(__file__)), "out-quick" if args.quick else "out")
+RECORD_INTERVAL = 0.01  # time between time-series samples [s]
+FIELD_INTERVAL = 0.05   # time between HDF5 frames [s]
+FAILURE_DISPLACEMENT = 0.02 * SCENE.pile_height  # toe displacement that marks failure [m]
+MOVING_DISPLACEMENT = 0.25 * CELL  # displacement that marks a point as part of the sliding mass [m]
+BALANCE_TOLERANCE = 1e-9  # relative water mass balance residual that stops the run [-]
+if not 0 < CELL <= SCENE.pile_height / 4:
+    raise ValueError("--cell = %r m is outside the valid range (0, %g] (at least 4 cells over the pile height)" % (CELL, SCENE.pile_height / 4))
+if not DURATION > 0:
+    raise ValueError("--duration = %r s is outside the valid range (0, inf)" % DURATION)
+os.makedirs(OUT, exist_ok=True)
+
+# --- materials and points -------------------------------------------------------------------------
+soil = MpmSoilMat(label="sand", density=SCENE.grain_density, youngModulus=SCENE.young_modulus, poissonRatio=SCENE.poisson_ratio,
+                  porosity=SCENE.porosity, intrinsicPermeability=SCENE.intrinsic_permeability(GRAVITY), model="MohrCoulomb",
+                  frictionAngle=SCENE.friction_angle, dilatancyAngle=SCENE.dilatancy_angle, cohesion=0.0,
+                  residualFrictionAngle=SCENE.residual_friction_angle, softeningStrain=SCENE.softening_strain)
+water = MpmWaterMat(label="water", density=SCENE.water_density, bulkModulus=SCENE.water_bulk_modulus, viscosity=SCENE.water_viscosity)
+O.materials.append([soil, water])
+positions, spacing = sandpile.pile_points(SCENE, CELL, points_per_cell=2)
+solid_body, water_body = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=GRAVITY,
+                                                   surface=SCENE.surface_height(positions[:, 0]), water_table=SCENE.head_start,
+                                                   lateral_earth_pressure=1 - math.sin(SCENE.friction_angle), suction_above_table=True)
+O.bodies.append([solid_body, water_body])
+solid, fluid = solid_body.shape, water_body.shape
+start_positions = solid.pos.copy()
+
+# --- engine: flume walls, inflow face, free surface, filtering cloth --------------------------------
+NO_TABLE = float("-inf")
+engine = MpmTwoPhaseEngine(
+    label="mpm", gravity=GRAVITY, domainMin=(0, 0, 0), domainMax=(SCENE.flume_length, SCENE.flume_width, SCENE.flume_height),
+    cellSize=CELL, shapeFunction="uGIMP",
+    #            xMin (inflow)  xMax      yMin (front)   yMax (rear)    zMin (base)    zMax
+    solidWalls=("slip",        "free",   "slip",        "slip",        "fixed",       "free"),
+    waterWalls=("drained",     "free",   "impermeable", "impermeable", "impermeable", "free"),
+    waterInflow=(True, False, False, False, False, False),
+    drainedWaterTable=(SCENE.head_start, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE),
+    freeSurfaceThreshold=0.75,  # p = 0 on the outer point layer: the pile's surface and seepage face
+    removeFreeWater=True)       # the filtering cloth
+recorder = MpmHdf5Recorder(label="recorder", file=os.path.join(OUT, "sandpile.h5"), iterPeriod=1)
+O.engines = [engine, recorder]
+
+
+def head_table(t):
+    return (SCENE.head(t), NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE)
+
+
+# --- probes and the toe ----------------------------------------------------------------------------
+toe = SCENE.toe_x()
+PROBES = {"upstream x=0.05": (0.05, 0.5 * SCENE.flume_width, 0.02),
+          "crest edge x=0.10": (SCENE.crest_length, 0.5 * SCENE.flume_width, 0.02),
+          "mid slope x=0.20": (0.20, 0.5 * SCENE.flume_width, 0.02),
+          "near toe x=0.27": (0.27, 0.5 * SCENE.flume_width, 0.01)}
+# the toe region: solid points within two cells of the toe along the base
+toe_points = np.flatnonzero((start_positions[:, 0] > toe - 2 * CELL) & (start_positions[:, 2] < 2 * CELL))
+
+
+def probe_pressure(location):
+    """Pore pressure [Pa] averaged over the water points within one point spacing of `location`."""
+    near = np.linalg.norm(fluid.pos - np.asarray(location), axis=1) < 1.01 * spacing
+    return float(fluid.porePressure[near].mean()) if near.any() else float("nan")
+
+
+def toe_displacement():
+    """Mean horizontal displacement [m] of the toe region's solid points."""
+    return float((solid.pos[toe_points, 0] - start_positions[toe_points, 0]).mean())
+
+
+initial_water = float(fluid.mass.sum())
+
+
+def mass_balance():
+    stored = float(fluid.mass.sum())
+    residual = (stored + engine.removedWaterMass - initial_water - engine.injectedWaterMass) / initial_water
+    return stored, residual
+
+
+# --- run -------------------------------------------------------------------------------------------
+# O.dt is the interval at which the head is updated; the engine sub-steps it to its stable step.
+O.dt = 2e-4
+steps_per_record = int(round(RECORD_INTERVAL / O.dt))
+records_per_frame = int(round(FIELD_INTERVAL / RECORD_INTERVAL))
+rows, snapshots = [], {}
+failure = None
+settled = None
+wall_start = time.time()
+record = 0
+while O.time < DURATION - 1e-12:
+    recorder.dead = record % records_per_frame != 0
+    for _ in range(steps_per_record):
+        engine.drainedWaterTable = head_table(O.time)
+        O.run(1, True)
+        recorder.dead = True
+    record += 1
+    stored, residual = mass_balance()
+    if not abs(residual) < BALANCE_TOLERANCE:
+        raise RuntimeError("water mass balance failed at t = %.4f s: (stored + removed − initial − injected)/initial = %.3e"
+                           % (O.time, residual))
+    speed = np.linalg.norm(solid.vel, axis=1)
+    row = {"time_s": O.time, "head_m": SCENE.head(O.time), "toe_displacement_m": toe_displacement(),
+           "max_solid_speed_m_per_s": float(speed.max()), "water_points": fluid.count, "injected_kg": engine.injectedWaterMass,
+           "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual}
+    row.update({"p_%s_Pa" % name.split()[0] + "_" + name.split()[1]: probe_pressure(loc) for name, loc in PROBES.items()})
+    rows.append(row)
+    if settled is None and O.time >= SCENE.settle_time - 1e-9:
+        settled = dict(row)
+        snapshots["end of settling"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
+    if failure is None and row["toe_displacement_m"] > FAILURE_DISPLACEMENT:
+        failure = dict(row)
+        snapshots["failure"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
+        failure_state = (solid.pos.copy(), solid.vel.copy())
+    mid = SCENE.settle_time + 0.5 * SCENE.head_ramp_time
+    if "mid rise" not in snapshots and O.time >= mid - 1e-9:
+        snapshots["mid rise"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
+    print("t = %.3f s  head %.4f m  toe %.2e m  max |v_s| %.2e m/s  water points %d  balance %.1e  (%.0f s)"
+          % (O.time, row["head_m"], row["toe_displacement_m"], row["max_solid_speed_m_per_s"], fluid.count, residual, time.time() - wall_start),
+          flush=True)
+run_time = time.time() - wall_start
+snapshots["end"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
+if failure is None:
+    failure_state = (solid.pos.copy(), solid.vel.copy())
+
+# --- sliding surface: the base of the mass that moved ---------------------------------------------
+displacement = np.linalg.norm(solid.pos - start_positions, axis=1)
+moving = displacement > MOVING_DISPLACEMENT
+x0, z0 = start_positions[:, 0], start_positions[:, 2]
+bins = np.arange(0, toe + CELL, spacing)
+surface_x, surface_z = [], []
+for lo in bins:
+    column = (x0 >= lo) & (x0 < lo + spacing)
+    if not (column & moving).any():
+        continue
+    # the sliding surface lies under the lowest moving point of the column (undeformed positions)
+    surface_x.append(lo + 0.5 * spacing)
+    surface_z.append(float(z0[column & moving].min()) - 0.5 * spacing)
+surface_x, surface_z = np.array(surface_x), np.array(surface_z)
+sliding = None
+if len(surface_x):
+    depth = SCENE.surface_height(surface_x) - surface_z
+    sliding = {"scarp_x_m": float(surface_x.min()), "exit_x_m": float(surface_x.max()),
+               "lowest_z_m": float(surface_z.min()), "max_depth_below_surface_m": float(depth.max()),
+               "exit_z_m": float(surface_z[np.argmax(surface_x)]),
+               "moving_volume_fraction": float(moving.mean()),
+               "passes_through_toe_region": bool(abs(surface_x.max() - toe) <= 2 * CELL and surface_z[np.argmax(surface_x)] <= 2 * CELL)}
+
+stored, residual = mass_balance()
+summary = {
+    "mode": "quick" if args.quick else "full",
+    "cell_size_m": CELL,
+    "points_per_phase_initial": int(len(positions)),
+    "scene": {k: getattr(SCENE, k) for k in SCENE.__dataclass_fields__},
+    "simulated_time_s": O.time,
+    "explicit_steps": int(engine.solverSteps),
+    "critical_time_step_s": engine.criticalTimeStep,
+    "run_time_s": run_time,
+    "threads": int(os.environ.get("OMP_NUM_THREADS", os.cpu_count())),
+    "stable_before_rise": {"toe_displacement_m": settled["toe_displacement_m"] if settled else None,
+                           "max_solid_speed_m_per_s": settled["max_solid_speed_m_per_s"] if settled else None},
+    "failure": None if failure is None else {"time_s": failure["time_s"], "head_m": failure["head_m"],
+                                              "criterion": "toe displacement > %.4f m" % FAILURE_DISPLACEMENT},
+    "sliding_surface": sliding,
+    "water_mass_balance": {"initial_kg": initial_water, "injected_kg": engine.injectedWaterMass, "removed_kg": engine.removedWaterMass,
+                           "stored_kg": stored, "relative_residual": residual},
+}
+with open(os.path.join(OUT, "summary.json"), "w") as f:
+    json.dump(summary, f, indent=2)
+with open(os.path.join(OUT, "time_series.csv"), "w", newline="") as f:
+    writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+    writer.writeheader()
+    writer.writerows(rows)
+
+# --- figures ---------------------------------------------------------------------------------------
+import matplotlib  # noqa: E402
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+xs = np.linspace(0, SCENE.flume_length, 200)
+outline = SCENE.surface_height(xs)
+pmax = SCENE.water_density * 9.81 * SCENE.head_end
+
+
+def frame(ax, title):
+    ax.plot(xs, outline, "k--", lw=0.8)
+    ax.set_xlim(0, min(SCENE.flume_length, toe + 0.1))
+    ax.set_ylim(0, SCENE.pile_height * 1.3)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("z [m]")
+    ax.set_title(title, fontsize=9)
+
+
+fig, axes = plt.subplots(len(snapshots), 1, figsize=(7, 2.2 * len(snapshots)))
+for ax, (label, (t, pos, p)) in zip(np.atleast_1d(axes), sorted(snapshots.items(), key=lambda kv: kv[1][0])):
+    order = np.argsort(pos[:, 1])  # nearest the viewer (front wall y = 0) drawn last
+    sc = ax.scatter(pos[order, 0], pos[order, 2], c=p[order], s=6, cmap="viridis", vmin=0, vmax=pmax)
+    frame(ax, "%s: t = %.2f s, head %.3f m" % (label, t, SCENE.head(t)))
+    fig.colorbar(sc, ax=ax, label="p [Pa]")
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "pore_pressure.png"), dpi=110)
+
+pos, vel = failure_state
+slab = np.abs(pos[:, 1] - 0.5 * SCENE.flume_width) < 0.5 * CELL
+fig, ax = plt.subplots(figsize=(7, 3))
+speed = np.linalg.norm(vel, axis=1)
+q = ax.quiver(pos[slab, 0], pos[slab, 2], vel[slab, 0], vel[slab, 2], speed[slab], cmap="plasma", scale_units="xy",
+              scale=max(speed[slab].max(), 1e-12) / (1.5 * spacing), width=0.003)
+fig.colorbar(q, ax=ax, label="|v_s| [m/s]")
+frame(ax, "solid velocity at %s (t = %.2f s), mid-width slab" % ("failure" if failure else "the end", failure["time_s"] if failure else O.time))
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "velocity_at_failure.png"), dpi=110)
+
+fig, ax = plt.subplots(figsize=(7, 3))
+kappa = solid.plasticShearStrain
+sc = ax.scatter(start_positions[:, 0], start_positions[:, 2], c=kappa, s=6, cmap="magma_r", vmin=0, vmax=max(np.percentile(kappa, 99), 1e-6))
+fig.colorbar(sc, ax=ax, label="κ, plastic shear strain [-]")
+if len(surface_x):
+    ax.plot(surface_x, surface_z, "c-", lw=2, label="sliding surface (base of the moved mass)")
+    ax.legend(fontsize=8, loc="upper right")
+frame(ax, "plastic shear strain at t = %.2f s on the undeformed pile" % O.time)
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "shear_band.png"), dpi=110)
+
+t = np.array([r["time_s"] for r in rows])
+fig, (a1, a2, a3) = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
+a1.plot(t, [r["head_m"] for r in rows])
+a1.set_ylabel("inflow head H [m]")
+for key in rows[0]:
+    if key.startswith("p_"):
+        a2.plot(t, [r[key] for r in rows], label=key[2:-3].replace("_", " "))
+a2.set_ylabel("pore pressure [Pa]")
+a2.legend(fontsize=7)
+a3.plot(t, 1e3 * np.array([r["toe_displacement_m"] for r in rows]))
+a3.axhline(1e3 * FAILURE_DISPLACEMENT, color="r", ls=":", label="failure criterion")
+a3.set_ylabel("toe displacement [mm]")
+a3.set_xlabel("t [s]")
+a3.legend(fontsize=7)
+if failure:
+    for a in (a1, a2, a3):
+        a.axvline(failure["time_s"], color="r", lw=0.8)
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "time_series.png"), dpi=110)
+print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "failure", "sliding_surface", "water_mass_balance", "stable_before_rise")}, indent=2))
