@@ -47,6 +47,7 @@ args = parser.parse_args(sys.argv[1:])
 
 SCENE = sandpile.DEFAULT
 GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
+G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]
 CELL = args.cell or (0.02 if args.quick else 0.01)  # h [m]
 DURATION = args.duration or SCENE.duration()  # [s]
 OUT = args.out or os.path.join(os.path.dirname(os.path.abspath(__file__)), "out-quick" if args.quick else "out")
@@ -204,7 +205,7 @@ summary = {
     "explicit_steps": int(engine.solverSteps),
     "critical_time_step_s": engine.criticalTimeStep,
     "run_time_s": run_time,
-    "threads": int(os.environ.get("OMP_NUM_THREADS", os.cpu_count())),
+    "threads": int(O.numThreads),
     "stable_before_rise": {"toe_displacement_m": settled["toe_displacement_m"] if settled else None,
                            "max_solid_speed_m_per_s": settled["max_solid_speed_m_per_s"] if settled else None},
     "failure": None if failure is None else {"time_s": failure["time_s"], "head_m": failure["head_m"],
@@ -227,7 +228,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 xs = np.linspace(0, SCENE.flume_length, 200)
 outline = SCENE.surface_height(xs)
-pmax = SCENE.water_density * 9.81 * SCENE.head_end
+pmax = SCENE.water_density * G * SCENE.head_end  # hydrostatic at the base under the final head [Pa]
+pmin = -SCENE.water_density * G * (SCENE.pile_height - SCENE.head_start)  # suction at the crest at the start [Pa]
 
 
 def frame(ax, title):
@@ -243,9 +245,10 @@ def frame(ax, title):
 fig, axes = plt.subplots(len(snapshots), 1, figsize=(7, 2.2 * len(snapshots)))
 for ax, (label, (t, pos, p)) in zip(np.atleast_1d(axes), sorted(snapshots.items(), key=lambda kv: kv[1][0])):
     order = np.argsort(pos[:, 1])  # nearest the viewer (front wall y = 0) drawn last
-    sc = ax.scatter(pos[order, 0], pos[order, 2], c=p[order], s=6, cmap="viridis", vmin=0, vmax=pmax)
+    sc = ax.scatter(pos[order, 0], pos[order, 2], c=p[order], s=6, cmap="RdYlBu_r",
+                    norm=matplotlib.colors.TwoSlopeNorm(vmin=pmin, vcenter=0, vmax=pmax))
     frame(ax, "%s: t = %.2f s, head %.3f m" % (label, t, SCENE.head(t)))
-    fig.colorbar(sc, ax=ax, label="p [Pa]")
+    fig.colorbar(sc, ax=ax, label="p [Pa] (< 0: suction)")
 fig.tight_layout()
 fig.savefig(os.path.join(OUT, "pore_pressure.png"), dpi=110)
 
