@@ -201,6 +201,7 @@ summary = {
     "cell_size_m": CELL,
     "points_per_phase_initial": int(len(positions)),
     "scene": {k: getattr(SCENE, k) for k in SCENE.__dataclass_fields__},
+    "gravity_m_per_s2": GRAVITY.tolist(),
     "simulated_time_s": O.time,
     "explicit_steps": int(engine.solverSteps),
     "critical_time_step_s": engine.criticalTimeStep,
