@@ -26,7 +26,7 @@ from yade_mpm import MpmSoilMat, MpmTwoPhaseEngine, MpmWaterMat, analytical
 
 parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
 parser.add_argument("--quick", action="store_true", help="coarse column (h = H/20, Kw = 0.22 GPa): about 10 s")
-parser.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "out"), help="output directory")
+parser.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "out"), help="output directory")
 args = parser.parse_args(sys.argv[1:])
 
 HEIGHT = 1.0  # H [m]

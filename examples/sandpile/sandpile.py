@@ -7,7 +7,8 @@ The scene (flume, pile, sand, water, head history) is yade_mpm.sandpile.DEFAULT,
 3D: the flume's front and rear walls (y = 0, width) are smooth and impermeable, the base is rough
 and impermeable, the upstream face x = 0 is a drained inflow face held at the hydrostatic profile
 of the rising head H(t) (water enters as new water points), the pile's surface is a free surface
-and seepage face (p = 0), and water that seeps out of the pile is taken by the filtering cloth
+that keeps the capillary suction above the phreatic line and is a seepage face (p = 0, water out,
+none in) below it, and water that seeps out of the pile is taken by the filtering cloth
 (removed once it has left the soil, its mass counted). Mohr–Coulomb sand with friction softening.
 
 Quick mode: cell h = 2 cm (6 cells over the pile height), a few minutes on 2 cores. Full mode:
@@ -50,7 +51,7 @@ GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
 G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]
 CELL = args.cell or (0.02 if args.quick else 0.01)  # h [m]
 DURATION = args.duration or SCENE.duration()  # [s]
-OUT = args.out or os.path.join(os.path.dirname(os.path.abspath(__file__)), "out-quick" if args.quick else "out")
+OUT = args.out or os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "out-quick" if args.quick else "out")
 RECORD_INTERVAL = 0.01  # time between time-series samples [s]
 FIELD_INTERVAL = 0.05   # time between HDF5 frames [s]
 FAILURE_DISPLACEMENT = 0.02 * SCENE.pile_height  # toe displacement that marks failure [m]
@@ -87,7 +88,8 @@ engine = MpmTwoPhaseEngine(
     waterWalls=("drained",     "free",   "impermeable", "impermeable", "impermeable", "free"),
     waterInflow=(True, False, False, False, False, False),
     drainedWaterTable=(SCENE.head_start, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE),
-    freeSurfaceThreshold=0.75,  # p = 0 on the outer point layer: the pile's surface and seepage face
+    freeSurfaceThreshold=0.75,  # the outer point layer is the pile's surface ...
+    freeSurfaceHoldsSuction=True,  # ... held by capillarity above the phreatic line, a seepage face below it
     removeFreeWater=True)       # the filtering cloth
 recorder = MpmHdf5Recorder(label="recorder", file=os.path.join(OUT, "sandpile.h5"), iterPeriod=1)
 O.engines = [engine, recorder]

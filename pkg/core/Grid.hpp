@@ -54,6 +54,7 @@ struct WaterNode {
 	Vec3 porousForce;   // Σ V_wp p (n ∇S + S ∇n), the −n∇p force on the water [N]
 	Vec3 pressureForce; // f^p_I = Σ V_wp p ∇S, pore-pressure part of the mixture force [N]
 	Real volume;        // Σ S V_wp, mixture volume carried by water points [m³] (free-surface detection)
+	Real pressureVolume; // Σ S V_wp p [Pa m³]; / volume: the nodal pore pressure (suction-holding surface)
 };
 
 inline SolidNode& operator+=(SolidNode& a, const SolidNode& b)
@@ -73,6 +74,7 @@ inline WaterNode& operator+=(WaterNode& a, const WaterNode& b)
 	a.weight += b.weight;
 	a.porousForce += b.porousForce;
 	a.pressureForce += b.pressureForce;
+	a.pressureVolume += b.pressureVolume;
 	a.volume += b.volume;
 	return a;
 }

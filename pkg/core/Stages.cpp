@@ -37,7 +37,7 @@ namespace {
 	// Race-free scatter: thread 0 adds into `target`, the others into private copies that are
 	// then summed node by node. Results differ between thread counts only by round-off.
 	inline SolidNode zeroOf(const SolidNode&) { return SolidNode { 0, Vec3::Zero(), Vec3::Zero(), 0, 0, 0 }; }
-	inline WaterNode zeroOf(const WaterNode&) { return WaterNode { 0, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0 }; }
+	inline WaterNode zeroOf(const WaterNode&) { return WaterNode { 0, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0, 0 }; }
 	inline Vec3      zeroOf(const Vec3&) { return Vec3::Zero(); }
 
 	template <class Node, class F> void scatter(std::vector<Node>& target, std::vector<std::vector<Node>>& buffers, std::size_t count, F&& perPoint)
@@ -169,6 +169,7 @@ namespace stages {
 					node.porousForce += (V * pressure) * (n * dN + N * gradN); // eq. 4.6
 					node.pressureForce += (V * pressure) * dN;                 // eq. 4.7
 					node.volume += N * V;
+					node.pressureVolume += N * V * pressure;
 				});
 			});
 		}
@@ -186,8 +187,25 @@ namespace stages {
 		}
 	}
 
+	void markSuctionHoldingNodes(const GridGeometry& grid, const GridFields& fields, Real threshold, Real solidMassTolerance,
+	                             Real waterMassTolerance, std::vector<char>& holding)
+	{
+		holding.assign(fields.water.size(), 0);
+		const int nx = grid.nodes[0], ny = grid.nodes[1], nz = grid.nodes[2];
+#pragma omp parallel for schedule(static) if(fields.water.size() > parallelThreshold)
+		for (int k = 0; k < nz; ++k)
+			for (int j = 0; j < ny; ++j)
+				for (int i = 0; i < nx; ++i) {
+					const std::size_t I = grid.index(i, j, k);
+					const WaterNode&  w = fields.water[I];
+					if (!(w.mass > waterMassTolerance && fields.solid[I].mass > solidMassTolerance && w.pressureVolume < 0)) continue;
+					const Real full = grid.inDomainSupport(0, i) * grid.inDomainSupport(1, j) * grid.inDomainSupport(2, k);
+					holding[I]      = full > 0 && w.volume < threshold * full;
+				}
+	}
+
 	void integrateNodalMomentum(GridFields& fields, const ConstrainedNodes& constrained, Real dt, DragScheme drag, Real solidMassTolerance,
-	                            Real waterMassTolerance)
+	                            Real waterMassTolerance, const std::vector<char>* suctionHolding)
 	{
 		const std::size_t nodes = fields.solid.size();
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
@@ -200,7 +218,9 @@ namespace stages {
 			const Vec3&      vs   = fields.solidVelocity[i];
 			const Vec3&      vw   = fields.waterVelocity[i];
 			Vec3             vsNew = Vec3::Zero(), vwNew = Vec3::Zero();
-			if (hasS && hasW) {
+			if (hasS && hasW && suctionHolding && (*suctionHolding)[i]) { // eq. 2.3b: no relative flow
+				vsNew = vwNew = (s.mass * vs + w.mass * vw + dt * fm) / (s.mass + w.mass);
+			} else if (hasS && hasW) {
 				const Real ms = s.mass, mw = w.mass, Q = s.drag, A = mw / dt;
 				if (drag == DragScheme::SemiImplicit) { // eq. 4.10, drag at t^{n+1}
 					vwNew = (A * vw + fw + Q * (vs + (mw / ms) * vw + (dt / ms) * fm)) / (A + Q * (1 + mw / ms));
@@ -229,10 +249,11 @@ namespace stages {
 			Vec3&      vsNew = fields.solidVelocityNew[i];
 			Vec3&      vwNew = fields.waterVelocityNew[i];
 			const Vec3 fm = s.mixtureForce + w.pressureForce + w.weight, fw = w.porousForce + w.weight;
+			const bool holding = hasS && hasW && suctionHolding && (*suctionHolding)[i];
 			for (int d = 0; d < 3; ++d) {
-				if (nc.solid[d]) vsNew[d] = 0;
-				if (nc.water[d]) vwNew[d] = 0;
-				if (!(hasS && hasW) || nc.solid[d] == nc.water[d]) continue;
+				if (nc.solid[d] || (holding && nc.water[d])) vsNew[d] = 0;
+				if (nc.water[d] || (holding && nc.solid[d])) vwNew[d] = 0;
+				if (!(hasS && hasW) || holding || nc.solid[d] == nc.water[d]) continue;
 				const Real ms = s.mass, mw = w.mass, Q = s.drag, A = mw / dt;
 				const Real vs = fields.solidVelocity[i][d], vw = fields.waterVelocity[i][d];
 				if (nc.solid[d]) vwNew[d] = drag == DragScheme::SemiImplicit ? (A * vw + fw[d]) / (A + Q) : vw + (dt / mw) * (fw[d] - Q * (vw - vs));
@@ -330,6 +351,67 @@ namespace stages {
 		}
 	}
 
+	template <class Kernel>
+	void averageThroughNodes(const GridGeometry& grid, const MaterialPointSet& P, std::vector<Real>& values, std::vector<Real>& nodeSum,
+	                         std::vector<Real>& nodeVolume)
+	{
+		const std::size_t count = P.size();
+		nodeSum.assign(grid.nodeCount(), 0);
+		nodeVolume.assign(grid.nodeCount(), 0);
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			const Real V = P.volume[p], f = values[p];
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+#pragma omp atomic
+				nodeSum[I] += N * V * f;
+#pragma omp atomic
+				nodeVolume[I] += N * V;
+			});
+		}
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			Real sum = 0, weight = 0;
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+				if (!(nodeVolume[I] > 0)) return;
+				sum += N * nodeSum[I] / nodeVolume[I];
+				weight += N;
+			});
+			values[p] = sum / weight; // the point's own volume makes every node of its stencil non-empty
+		}
+	}
+
+	template <class Kernel>
+	void dampPressureModes(const GridGeometry& grid, const GridFields& fields, Real relax, WaterPointSet& P, std::vector<Real>& smoothed,
+	                       std::vector<Real>& nodeSum, std::vector<Real>& nodeVolume)
+	{
+		smoothed = P.porePressure;
+		averageThroughNodes<Kernel>(grid, P, smoothed, nodeSum, nodeVolume);
+		const std::size_t count = P.size();
+		// a node is interior when off the wall planes with its full support filled (1e-3 slack for
+		// compression); points near edges keep their pressure, where p̃ is one-sided
+		auto interior = [&](int i, int j, int k) {
+			const int idx[3] = { i, j, k };
+			for (int d = 0; d < 3; ++d)
+				if (idx[d] <= grid.wallNode[d] || idx[d] >= grid.upperWallNode[d]) return false;
+			return fields.water[grid.index(i, j, k)].volume >= (1 - 1e-3) * grid.cellSize * grid.cellSize * grid.cellSize;
+		};
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			bool inside = true;
+			for (int c = 0; c < Kernel::stencil && inside; ++c)
+				for (int b = 0; b < Kernel::stencil && inside; ++b)
+					for (int a = 0; a < Kernel::stencil && inside; ++a)
+						if (w[0].value[a] * w[1].value[b] * w[2].value[c] > 0) inside = interior(w[0].first + a, w[1].first + b, w[2].first + c);
+			if (inside) P.porePressure[p] += relax * (smoothed[p] - P.porePressure[p]);
+		}
+	}
+
 	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, SolidSet& set, Real dt)
 	{
 		SolidPointSet&    P      = *set.points;
@@ -397,7 +479,7 @@ namespace stages {
 		}
 	}
 
-	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, WaterPointSet& P)
+	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& P)
 	{
 		const std::size_t count = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
@@ -415,8 +497,7 @@ namespace stages {
 						const Real expected = grid.inDomainSupport(0, i) * grid.inDomainSupport(1, j) * grid.inDomainSupport(2, k); // full support volume
 						filling += N * (expected > 0 ? fields.water[grid.index(i, j, k)].volume / expected : 1.0);
 					}
-			const bool surface = filling < threshold;
-			if (surface) P.porePressure[p] = 0;
+			if (filling < threshold) P.porePressure[p] = keepSuction ? std::min<Real>(P.porePressure[p], 0) : 0;
 		}
 	}
 
@@ -456,6 +537,10 @@ namespace stages {
 	template void computeVelocityGradients<K>(const GridGeometry&, const std::vector<Vec3>&, const MaterialPointSet&, std::vector<Mat3>&);  \
 	template void computePressureRates<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const WaterPointSet&,   \
 	                                     const WaterParameters&, std::vector<Real>&, std::vector<Real>&);                                   \
+	template void averageThroughNodes<K>(const GridGeometry&, const MaterialPointSet&, std::vector<Real>&, std::vector<Real>&,             \
+	                                    std::vector<Real>&);                                                                               \
+	template void dampPressureModes<K>(const GridGeometry&, const GridFields&, Real, WaterPointSet&, std::vector<Real>&, std::vector<Real>&, \
+	                                  std::vector<Real>&);                                                                                 \
 	template long firstPointOutsideGrid<K>(const GridGeometry&, const MaterialPointSet&);
 
 	MPM_INSTANTIATE_STAGES(LinearKernel)

@@ -78,10 +78,17 @@ namespace stages {
 	// Step 5: v_I = P_I / m_I for nodes above the mass tolerance, else 0.
 	void computeNodalVelocities(GridFields& fields, Real solidMassTolerance, Real waterMassTolerance);
 
+	// Suction-holding free surface (theory.md eq. 2.3b): marks (1) the nodes whose filling
+	// V^w_I/V^full_I is below `threshold`, that carry solid and water, and whose nodal pore
+	// pressure Σ S V p / Σ S V is negative: there capillary menisci hold the water to the grains.
+	void markSuctionHoldingNodes(const GridGeometry& grid, const GridFields& fields, Real threshold, Real solidMassTolerance,
+	                             Real waterMassTolerance, std::vector<char>& holding);
+
 	// Step 6 (theory.md eqs. 4.8–4.10): coupled nodal momentum of water and mixture with
-	// semi-implicit or explicit drag, then the velocity constraints of the walls.
+	// semi-implicit or explicit drag, then the velocity constraints of the walls. Nodes marked in
+	// `suctionHolding` (may be null) move both phases with the mixture velocity (eq. 2.3b).
 	void integrateNodalMomentum(GridFields& fields, const ConstrainedNodes& constrained, Real dt, DragScheme drag,
-	                            Real solidMassTolerance, Real waterMassTolerance);
+	                            Real solidMassTolerance, Real waterMassTolerance, const std::vector<char>* suctionHolding = nullptr);
 
 	// Step 7 (theory.md eq. 4.11): G2P with FLIP/PIC blend α; positions move with the new grid
 	// velocity. Returns the index of the first runaway point, or -1: one whose velocity is not
@@ -109,6 +116,22 @@ namespace stages {
 	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& points, std::vector<Real>& values, std::vector<Real>& cellSum,
 	                      std::vector<Real>& cellVolume);
 
+	// Replace each point's value by its interpolation Σ S_I f_I from the nodal volume-weighted means
+	// f_I = Σ S V f / Σ S V (theory.md eq. 4.17b). Exact for fields linear in space away from the
+	// material's edges; it removes cell checkerboards (their nodal means vanish) and damps node
+	// checkerboards. `nodeSum`/`nodeVolume` are scratch arrays of grid.nodeCount() entries.
+	template <class Kernel>
+	void averageThroughNodes(const GridGeometry& grid, const MaterialPointSet& points, std::vector<Real>& values, std::vector<Real>& nodeSum,
+	                         std::vector<Real>& nodeVolume);
+
+	// Pressure-mode damping (theory.md eq. 4.17b): p ← p + r (p̃ − p), with p̃ the nodal average
+	// (averageThroughNodes), on points whose stencil nodes all lie in the material's interior (full
+	// water support, off the wall planes), where p̃ = p for any linear field: hydrostatic and
+	// steady-seepage states are untouched, while modes that exert no nodal force decay.
+	template <class Kernel>
+	void dampPressureModes(const GridGeometry& grid, const GridFields& fields, Real relax, WaterPointSet& points, std::vector<Real>& smoothed,
+	                       std::vector<Real>& nodeSum, std::vector<Real>& nodeVolume);
+
 	// Step 9 (theory.md eqs. 4.14–4.15, §7): deformation gradient, volume, Jaumann elastic trial
 	// stress, return mapping of the set's skeleton model, porosity; `volumetricRate` (one per
 	// point) replaces tr d when given (cell-averaged volumetric strain rate, B-bar).
@@ -126,8 +149,9 @@ namespace stages {
 
 	// Free surface (theory.md eq. 2.3): p = 0 on water points whose filling Σ S_I V^w_I/V^full_I
 	// (nodal water-point volume over the node's full in-domain support volume) is below `threshold`;
-	// with 2 points per cell and axis the outer layer has 0.625 and the next 0.875.
-	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, WaterPointSet& points);
+	// with 2 points per cell and axis the outer layer has 0.625 and the next 0.875. With
+	// `keepSuction` only positive pressures are released, p = min(p, 0) (a seepage face, eq. 2.3b).
+	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& points);
 
 	// Step 11 (theory.md eq. 3.3): cpGIMP domains follow the stretch, l_i = l0_i F_ii in [0.01 h, h/2].
 	void updateDomainsCpGimp(SolidPointSet& points, Real cellSize);

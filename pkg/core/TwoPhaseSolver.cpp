@@ -58,6 +58,9 @@ void SolverSettings::validate() const
 	requireClosedRange("flipBlend", flipBlend, 0, 1, "");
 	requireOpenRange("timeStepFactor", timeStepFactor, 0, 1 + 1e-15, "");
 	if (!(freeSurfaceThreshold >= 0 && freeSurfaceThreshold < 1)) throwOutOfRange("freeSurfaceThreshold", freeSurfaceThreshold, "", "[0, 1)");
+	if (freeSurfaceHoldsSuction && !(freeSurfaceThreshold > 0))
+		throw InvalidParameter("freeSurfaceHoldsSuction = true needs a free surface: freeSurfaceThreshold = " + std::to_string(freeSurfaceThreshold) +
+		                       " must lie in (0, 1)");
 	if (!gravity.allFinite()) throw InvalidParameter("gravity must have finite components [m s⁻²]");
 }
 
@@ -93,6 +96,12 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 	solids_ = std::move(solids);
 	waters_ = std::move(waters);
 	water_  = water;
+	// consolidation coefficient c_v = κ M / μw of the fastest-draining soil (eq. 4.17b)
+	pressureDiffusivity_ = 0;
+	for (const SolidSet& set : solids_) {
+		const Real M         = 1 / (1 / set.soil.constrainedModulus() + set.soil.porosity / water_.bulkModulus);
+		pressureDiffusivity_ = std::max(pressureDiffusivity_, set.soil.intrinsicPermeability * M / water_.viscosity);
+	}
 	// a node is "empty" below a billionth of the lightest point's mass (theory.md §4, step 5)
 	solidMassTolerance_ = std::isfinite(minSolid) ? 1e-9 * minSolid : 0;
 	waterMassTolerance_ = std::isfinite(minWater) ? 1e-9 * minWater : 0;
@@ -178,7 +187,9 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	{
 		StageTimer t(stageSeconds_, Stage::IntegrateNodalMomentum);
 		computeNodalVelocities(fields_, solidMassTolerance_, waterMassTolerance_);
-		integrateNodalMomentum(fields_, constrained_, dt, settings_.drag, solidMassTolerance_, waterMassTolerance_);
+		const bool holdSuction = wet && settings_.freeSurfaceHoldsSuction;
+		if (holdSuction) markSuctionHoldingNodes(grid_, fields_, settings_.freeSurfaceThreshold, solidMassTolerance_, waterMassTolerance_, suctionHolding_);
+		integrateNodalMomentum(fields_, constrained_, dt, settings_.drag, solidMassTolerance_, waterMassTolerance_, holdSuction ? &suctionHolding_ : nullptr);
 	}
 	{
 		StageTimer t(stageSeconds_, Stage::UpdatePointKinematics);
@@ -232,7 +243,11 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 				averageOverCells(grid_, *w, waterDivergence_, cellSum_, cellVolume_);
 			}
 			updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
-			if (settings_.freeSurfaceThreshold > 0) applyFreeSurface(grid_, fields_, settings_.freeSurfaceThreshold, *w);
+			if (settings_.pressureModeDamping && pressureDiffusivity_ > 0) {
+				const Real relax = std::min<Real>(1, dt * pressureDiffusivity_ / (grid_.cellSize * grid_.cellSize));
+				dampPressureModes<Kernel>(grid_, fields_, relax, *w, smoothedPressure_, cellSum_, cellVolume_);
+			}
+			if (settings_.freeSurfaceThreshold > 0) applyFreeSurface(grid_, fields_, settings_.freeSurfaceThreshold, settings_.freeSurfaceHoldsSuction, *w);
 			applyDrainedFaces(grid_, domain_.boundaries, settings_.gravity, water_.density, *w);
 		}
 	}

@@ -18,7 +18,9 @@ struct SolverSettings {
 	Real          timeStepFactor = 0.5;  // C [-], 0 < C ≤ 1, applied to the critical step
 	Vec3          gravity        = Vec3::Zero(); // b [m s⁻²]
 	bool          cellAveragedVolumetricRate = true; // theory.md eq. 4.17 (pressure and B-bar)
+	bool          pressureModeDamping        = true;  // eq. 4.17b: pressure modes the grid cannot see decay as a one-cell seepage would
 	Real          freeSurfaceThreshold       = 0;    // β [-], 0 ≤ β < 1: p = 0 on points filled below β (eq. 2.3); 0: off
+	bool          freeSurfaceHoldsSuction    = false; // eq. 2.3b: the surface keeps suction (p < 0) and releases only p > 0 (a seepage face)
 	void          validate() const;
 };
 
@@ -116,6 +118,9 @@ private:
 	TimeStepLimits                lastLimits_ {};
 	void                          removeOutflowingWater();
 	std::vector<char>             removeFlags_;
+	std::vector<char>             suctionHolding_; // nodes of the suction-holding free surface (eq. 2.3b)
+	std::vector<Real>             smoothedPressure_;
+	Real                          pressureDiffusivity_ = 0; // c_v [m² s⁻¹] of eq. 4.17b
 	std::array<double, static_cast<int>(Stage::Count)> stageSeconds_ {};
 };
 

@@ -90,7 +90,9 @@ mpm::SolverSettings MpmTwoPhaseEngine::settings() const
 	s.timeStepFactor             = timeStepFactor;
 	s.gravity                    = gravity;
 	s.cellAveragedVolumetricRate = cellAveraging;
+	s.pressureModeDamping        = pressureModeDamping;
 	s.freeSurfaceThreshold       = freeSurfaceThreshold;
+	s.freeSurfaceHoldsSuction    = freeSurfaceHoldsSuction;
 	s.validate();
 	return s;
 }
@@ -147,7 +149,7 @@ void MpmTwoPhaseEngine::action()
 MpmTwoPhaseEngine::Structure MpmTwoPhaseEngine::structure() const
 {
 	return Structure { gravity,       timeStepFactor, flipBlend,  domainMin,  domainMax,  cellSize,               shapeFunction, drag,
-		           cellAveraging, freeSurfaceThreshold, solidWalls, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow };
+		           cellAveraging, pressureModeDamping, freeSurfaceThreshold, freeSurfaceHoldsSuction, solidWalls, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow };
 }
 
 void MpmTwoPhaseEngine::callPostLoad()
@@ -183,8 +185,12 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		stringAttr("shapeFunction", &E::shapeFunction, "Shape functions [-]: 'linear', 'uGIMP' (constant point domains) or 'cpGIMP' (domains follow the stretch)"),
 		stringAttr("drag", &E::drag, "Drag integration [-]: 'semi-implicit' (no drag time-step limit) or 'explicit'"),
 		boolAttr("cellAveraging", &E::cellAveraging, "Cell-averaged volumetric rates for the pore pressure and the skeleton (suppresses the pressure checkerboard) [-]"),
+		boolAttr("pressureModeDamping", &E::pressureModeDamping,
+		         "Pore-pressure modes the grid cannot see (cell and node checkerboards, which exert no nodal force and so are never drained) relax towards the nodal average at the rate c_v/h² at which seepage drains a one-cell perturbation (theory.md eq. 4.17b); off, they can grow without bound in long runs [-]"),
 		realAttr("freeSurfaceThreshold", &E::freeSurfaceThreshold,
 		         "Free-surface detection β [-], 0 ≤ β < 1: water points whose filling Σ S V_water/V_full of their nodes is below β get p = 0 (0.75 keeps exactly the outer layer with 2 points per cell and axis); 0: off"),
+		boolAttr("freeSurfaceHoldsSuction", &E::freeSurfaceHoldsSuction,
+		         "With a free surface (freeSurfaceThreshold > 0): the surface keeps suction (p < 0), as capillary menisci hold the water to the grains there (no relative flow at its nodes), and releases only positive pressure, p = min(p, 0): a seepage face that lets water out but draws none in. False: p = 0 on every free-surface point, as under ponded water [-]"),
 		fixedListAttr("solidWalls", &E::solidWalls, 6, "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0) or 'fixed'"),
 		fixedListAttr("waterWalls", &E::waterWalls, 6, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
 		fixedListAttr("drainedPressure", &E::drainedPressure, 6, "Uniform part of the pore pressure p̄ held on each 'drained' face [Pa]"),
@@ -258,7 +264,9 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& BOOST_SERIALIZATION_NVP(shapeFunction);
 	ar& BOOST_SERIALIZATION_NVP(drag);
 	ar& BOOST_SERIALIZATION_NVP(cellAveraging);
+	ar& BOOST_SERIALIZATION_NVP(pressureModeDamping);
 	ar& BOOST_SERIALIZATION_NVP(freeSurfaceThreshold);
+	ar& BOOST_SERIALIZATION_NVP(freeSurfaceHoldsSuction);
 	ar& BOOST_SERIALIZATION_NVP(solidWalls);
 	ar& BOOST_SERIALIZATION_NVP(waterWalls);
 	ar& BOOST_SERIALIZATION_NVP(drainedPressure);

@@ -26,7 +26,9 @@ public:
 	std::string    shapeFunction  = "uGIMP";                // linear | uGIMP | cpGIMP
 	std::string    drag           = "semi-implicit";        // semi-implicit | explicit
 	bool           cellAveraging  = true;                   // cell-averaged volumetric rates
+	bool           pressureModeDamping = true;              // grid-invisible pressure modes decay (theory.md eq. 4.17b)
 	yade::Real     freeSurfaceThreshold = 0;                // β [-]: p = 0 on water points filled below β; 0 off
+	bool           freeSurfaceHoldsSuction = false;         // the free surface keeps suction, releases only p > 0 (seepage face)
 	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed
 	std::vector<std::string> waterWalls { 6, "free" };      // free | impermeable | drained
 	std::vector<yade::Real>  drainedPressure = std::vector<yade::Real>(6, 0.0); // p̄ per face [Pa]
@@ -65,7 +67,7 @@ public:
 private:
 	// Everything the solver is built from except the values held on drained faces, which a
 	// running solver takes over in place (a rising head set every step must not rebuild it).
-	using Structure = std::tuple<yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, yade::Real,
+	using Structure = std::tuple<yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, bool, yade::Real, bool,
 	                             std::vector<std::string>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>>;
 	Structure structure() const;
 

@@ -19,7 +19,7 @@ struct OneNode {
 	{
 		fields.resize(1);
 		fields.solid[0]         = SolidNode { ms, ms * vs, fSolid, 1, 0.6, Q };
-		fields.water[0]         = WaterNode { mw, mw * vw, Vec3::Zero(), fWater, Vec3::Zero(), 0 };
+		fields.water[0]         = WaterNode { mw, mw * vw, Vec3::Zero(), fWater, Vec3::Zero(), 0, 0 };
 		fields.solidVelocity[0] = vs;
 		fields.waterVelocity[0] = vw;
 	}
@@ -99,7 +99,7 @@ TEST(Walls, HeldSolidComponentReSolvesTheWaterWithDragToIt)
 	const std::size_t I = g.index(1, 1, 1); // on the base wall
 	const Real        Q = 7, mw = 0.5, dt = 1e-2;
 	fields.solid[I]     = SolidNode { 2.0, 2.0 * vs0, fs, 1, 0.6, Q };
-	fields.water[I]     = WaterNode { mw, mw * vw0, Vec3::Zero(), fw, Vec3::Zero(), 0 };
+	fields.water[I]     = WaterNode { mw, mw * vw0, Vec3::Zero(), fw, Vec3::Zero(), 0, 0 };
 	fields.solidVelocity[I] = vs0;
 	fields.waterVelocity[I] = vw0;
 	stages::integrateNodalMomentum(fields, c, dt, DragScheme::SemiImplicit, 1e-12, 1e-12);
