@@ -33,7 +33,9 @@ struct GridGeometry {
 		if (i < wallNode[d] || i > upperWallNode[d]) return 0;
 		return i == wallNode[d] || i == upperWallNode[d] ? cellSize / 2 : cellSize;
 	}
-	Vec3                upper() const { return nodePosition(upperWallNode[0], upperWallNode[1], upperWallNode[2]); }
+	// Volume of node (i, j, k)'s support inside the domain box [m³] (h³ inside, halved per wall plane)
+	Real inDomainSupportVolume(int i, int j, int k) const { return inDomainSupport(0, i) * inDomainSupport(1, j) * inDomainSupport(2, k); }
+	Vec3 upper() const { return nodePosition(upperWallNode[0], upperWallNode[1], upperWallNode[2]); }
 };
 
 // Nodal quantities mapped from the solid points.
@@ -56,6 +58,19 @@ struct WaterNode {
 	Real volume;        // Σ S V_wp, mixture volume carried by water points [m³] (free-surface detection)
 	Real pressureVolume; // Σ S V_wp p [Pa m³]; / volume: the nodal pore pressure (suction-holding surface)
 };
+
+// Nodal sums of the current pore pressure (pressure-mode damping, theory.md eq. 4.17b).
+struct PressureNode {
+	Real pressureVolume; // Σ S V_wp p [Pa m³]
+	Real volume;         // Σ S V_wp [m³]
+};
+
+inline PressureNode& operator+=(PressureNode& a, const PressureNode& b)
+{
+	a.pressureVolume += b.pressureVolume;
+	a.volume += b.volume;
+	return a;
+}
 
 inline SolidNode& operator+=(SolidNode& a, const SolidNode& b)
 {

@@ -39,6 +39,7 @@ namespace {
 	inline SolidNode zeroOf(const SolidNode&) { return SolidNode { 0, Vec3::Zero(), Vec3::Zero(), 0, 0, 0 }; }
 	inline WaterNode zeroOf(const WaterNode&) { return WaterNode { 0, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0, 0 }; }
 	inline Vec3      zeroOf(const Vec3&) { return Vec3::Zero(); }
+	inline PressureNode zeroOf(const PressureNode&) { return PressureNode { 0, 0 }; }
 
 	template <class Node, class F> void scatter(std::vector<Node>& target, std::vector<std::vector<Node>>& buffers, std::size_t count, F&& perPoint)
 	{
@@ -199,7 +200,7 @@ namespace stages {
 					const std::size_t I = grid.index(i, j, k);
 					const WaterNode&  w = fields.water[I];
 					if (!(w.mass > waterMassTolerance && fields.solid[I].mass > solidMassTolerance && w.pressureVolume < 0)) continue;
-					const Real full = grid.inDomainSupport(0, i) * grid.inDomainSupport(1, j) * grid.inDomainSupport(2, k);
+					const Real full = grid.inDomainSupportVolume(i, j, k);
 					holding[I]      = full > 0 && w.volume < threshold * full;
 				}
 	}
@@ -352,63 +353,41 @@ namespace stages {
 	}
 
 	template <class Kernel>
-	void averageThroughNodes(const GridGeometry& grid, const MaterialPointSet& P, std::vector<Real>& values, std::vector<Real>& nodeSum,
-	                         std::vector<Real>& nodeVolume)
+	void dampPressureModes(const GridGeometry& grid, const GridFields& fields, Real relax, WaterPointSet& P, std::vector<PressureNode>& nodes,
+	                       ScatterWorkspace& workspace)
 	{
 		const std::size_t count = P.size();
-		nodeSum.assign(grid.nodeCount(), 0);
-		nodeVolume.assign(grid.nodeCount(), 0);
-#pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t p = 0; p < count; ++p) {
+		nodes.assign(grid.nodeCount(), zeroOf(PressureNode {}));
+		scatter(nodes, workspace.pressure, count, [&](std::size_t p, PressureNode* target) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
-			const Real V = P.volume[p], f = values[p];
+			const Real V = P.volume[p], pV = V * P.porePressure[p];
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
-#pragma omp atomic
-				nodeSum[I] += N * V * f;
-#pragma omp atomic
-				nodeVolume[I] += N * V;
+				target[I].pressureVolume += N * pV;
+				target[I].volume += N * V;
 			});
-		}
-#pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t p = 0; p < count; ++p) {
-			Weights1D w[3];
-			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
-			Real sum = 0, weight = 0;
-			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
-				if (!(nodeVolume[I] > 0)) return;
-				sum += N * nodeSum[I] / nodeVolume[I];
-				weight += N;
-			});
-			values[p] = sum / weight; // the point's own volume makes every node of its stencil non-empty
-		}
-	}
-
-	template <class Kernel>
-	void dampPressureModes(const GridGeometry& grid, const GridFields& fields, Real relax, WaterPointSet& P, std::vector<Real>& smoothed,
-	                       std::vector<Real>& nodeSum, std::vector<Real>& nodeVolume)
-	{
-		smoothed = P.porePressure;
-		averageThroughNodes<Kernel>(grid, P, smoothed, nodeSum, nodeVolume);
-		const std::size_t count = P.size();
-		// a node is interior when off the wall planes with its full support filled (1e-3 slack for
-		// compression); points near edges keep their pressure, where p̃ is one-sided
-		auto interior = [&](int i, int j, int k) {
-			const int idx[3] = { i, j, k };
-			for (int d = 0; d < 3; ++d)
-				if (idx[d] <= grid.wallNode[d] || idx[d] >= grid.upperWallNode[d]) return false;
-			return fields.water[grid.index(i, j, k)].volume >= (1 - 1e-3) * grid.cellSize * grid.cellSize * grid.cellSize;
-		};
+		});
+		// A node is interior when off the wall planes with its full support filled at the start of
+		// the step (1e-3 slack for compression); near edges p̃ is one-sided and p is left alone.
+		const Real fullVolume = (1 - 1e-3) * grid.cellSize * grid.cellSize * grid.cellSize;
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
 			bool inside = true;
+			Real smoothed = 0;
 			for (int c = 0; c < Kernel::stencil && inside; ++c)
 				for (int b = 0; b < Kernel::stencil && inside; ++b)
-					for (int a = 0; a < Kernel::stencil && inside; ++a)
-						if (w[0].value[a] * w[1].value[b] * w[2].value[c] > 0) inside = interior(w[0].first + a, w[1].first + b, w[2].first + c);
-			if (inside) P.porePressure[p] += relax * (smoothed[p] - P.porePressure[p]);
+					for (int a = 0; a < Kernel::stencil && inside; ++a) {
+						const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
+						if (N <= 0) continue;
+						const int idx[3] = { w[0].first + a, w[1].first + b, w[2].first + c };
+						for (int d = 0; d < 3; ++d) inside = inside && idx[d] > grid.wallNode[d] && idx[d] < grid.upperWallNode[d];
+						const std::size_t I = grid.index(idx[0], idx[1], idx[2]);
+						inside              = inside && fields.water[I].volume >= fullVolume;
+						if (inside) smoothed += N * nodes[I].pressureVolume / nodes[I].volume; // the point's own volume makes nodes[I] non-empty
+					}
+			if (inside) P.porePressure[p] += relax * (smoothed - P.porePressure[p]);
 		}
 	}
 
@@ -494,7 +473,7 @@ namespace stages {
 						const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
 						if (N <= 0) continue;
 						const int  i = w[0].first + a, j = w[1].first + b, k = w[2].first + c;
-						const Real expected = grid.inDomainSupport(0, i) * grid.inDomainSupport(1, j) * grid.inDomainSupport(2, k); // full support volume
+						const Real expected = grid.inDomainSupportVolume(i, j, k);
 						filling += N * (expected > 0 ? fields.water[grid.index(i, j, k)].volume / expected : 1.0);
 					}
 			if (filling < threshold) P.porePressure[p] = keepSuction ? std::min<Real>(P.porePressure[p], 0) : 0;
@@ -537,10 +516,8 @@ namespace stages {
 	template void computeVelocityGradients<K>(const GridGeometry&, const std::vector<Vec3>&, const MaterialPointSet&, std::vector<Mat3>&);  \
 	template void computePressureRates<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const WaterPointSet&,   \
 	                                     const WaterParameters&, std::vector<Real>&, std::vector<Real>&);                                   \
-	template void averageThroughNodes<K>(const GridGeometry&, const MaterialPointSet&, std::vector<Real>&, std::vector<Real>&,             \
-	                                    std::vector<Real>&);                                                                               \
-	template void dampPressureModes<K>(const GridGeometry&, const GridFields&, Real, WaterPointSet&, std::vector<Real>&, std::vector<Real>&, \
-	                                  std::vector<Real>&);                                                                                 \
+	template void dampPressureModes<K>(const GridGeometry&, const GridFields&, Real, WaterPointSet&, std::vector<PressureNode>&,            \
+	                                  ScatterWorkspace&);                                                                                  \
 	template long firstPointOutsideGrid<K>(const GridGeometry&, const MaterialPointSet&);
 
 	MPM_INSTANTIATE_STAGES(LinearKernel)

@@ -46,6 +46,7 @@ struct ScatterWorkspace {
 	std::vector<std::vector<SolidNode>> solid;
 	std::vector<std::vector<WaterNode>> water;
 	std::vector<std::vector<Vec3>>      momentum;
+	std::vector<std::vector<PressureNode>> pressure;
 };
 
 // Grid nodes whose velocity has at least one constrained component, and the constraint.
@@ -116,21 +117,14 @@ namespace stages {
 	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& points, std::vector<Real>& values, std::vector<Real>& cellSum,
 	                      std::vector<Real>& cellVolume);
 
-	// Replace each point's value by its interpolation Σ S_I f_I from the nodal volume-weighted means
-	// f_I = Σ S V f / Σ S V (theory.md eq. 4.17b). Exact for fields linear in space away from the
-	// material's edges; it removes cell checkerboards (their nodal means vanish) and damps node
-	// checkerboards. `nodeSum`/`nodeVolume` are scratch arrays of grid.nodeCount() entries.
+	// Pressure-mode damping (theory.md eq. 4.17b): p ← p + r (p̃ − p), with p̃ = Σ S_I p_I the
+	// interpolation of the nodal means p_I = Σ S V p / Σ S V, on points whose stencil nodes all lie
+	// in the material's interior (full water support, off the wall planes), where p̃ = p for any
+	// linear field: hydrostatic and steady-seepage states are untouched, while modes that exert no
+	// nodal force (cell and node checkerboards) decay. `nodes` is scratch of grid.nodeCount().
 	template <class Kernel>
-	void averageThroughNodes(const GridGeometry& grid, const MaterialPointSet& points, std::vector<Real>& values, std::vector<Real>& nodeSum,
-	                         std::vector<Real>& nodeVolume);
-
-	// Pressure-mode damping (theory.md eq. 4.17b): p ← p + r (p̃ − p), with p̃ the nodal average
-	// (averageThroughNodes), on points whose stencil nodes all lie in the material's interior (full
-	// water support, off the wall planes), where p̃ = p for any linear field: hydrostatic and
-	// steady-seepage states are untouched, while modes that exert no nodal force decay.
-	template <class Kernel>
-	void dampPressureModes(const GridGeometry& grid, const GridFields& fields, Real relax, WaterPointSet& points, std::vector<Real>& smoothed,
-	                       std::vector<Real>& nodeSum, std::vector<Real>& nodeVolume);
+	void dampPressureModes(const GridGeometry& grid, const GridFields& fields, Real relax, WaterPointSet& points, std::vector<PressureNode>& nodes,
+	                       ScatterWorkspace& workspace);
 
 	// Step 9 (theory.md eqs. 4.14–4.15, §7): deformation gradient, volume, Jaumann elastic trial
 	// stress, return mapping of the set's skeleton model, porosity; `volumetricRate` (one per

@@ -245,7 +245,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 			updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
 			if (settings_.pressureModeDamping && pressureDiffusivity_ > 0) {
 				const Real relax = std::min<Real>(1, dt * pressureDiffusivity_ / (grid_.cellSize * grid_.cellSize));
-				dampPressureModes<Kernel>(grid_, fields_, relax, *w, smoothedPressure_, cellSum_, cellVolume_);
+				dampPressureModes<Kernel>(grid_, fields_, relax, *w, pressureNodes_, workspace_);
 			}
 			if (settings_.freeSurfaceThreshold > 0) applyFreeSurface(grid_, fields_, settings_.freeSurfaceThreshold, settings_.freeSurfaceHoldsSuction, *w);
 			applyDrainedFaces(grid_, domain_.boundaries, settings_.gravity, water_.density, *w);

@@ -357,7 +357,7 @@ double suctionColumnBasePressureRise(bool holdSuction, double* maxError, double*
 		if (z < h / 2) baseP += c.fluid.porePressure[p], ++baseCount;
 	}
 	const double rise = (baseP / baseCount - gammaW * (tableZ - h / 4)) / (gammaW * (H - tableZ));
-	std::printf("suction column (%s): after 20 T = %.3f s base pressure rise %.3f of γw (H − z_w), max p error %.3f of it, max speed %.2e m/s\n",
+	std::printf("suction column (%s): after 20 T = %.3f s base pressure rise %.2e of γw (H − z_w), max p error %.2e of it, max speed %.2e m/s\n",
 	            holdSuction ? "held" : "released", 20 * consolidationTime, rise, *maxError, *maxSpeed);
 	return rise;
 }
@@ -366,14 +366,17 @@ TEST(FreeSurface, SuctionHoldingSurfaceKeepsACapillaryColumnAtRest)
 {
 	double error = 0, speed = 0;
 	const double rise = suctionColumnBasePressureRise(true, &error, &speed);
-	EXPECT_LT(std::abs(rise), 0.02);
-	EXPECT_LT(error, 0.05);
-	EXPECT_LT(speed, 1e-4);
+	// The held column is a discrete equilibrium: nothing moves it but round-off and the top cell's
+	// settling as it takes up its load (µm). 1e-3 of the suction range is what theory.md states.
+	EXPECT_LT(std::abs(rise), 1e-3);
+	EXPECT_LT(error, 1e-3);
+	EXPECT_LT(speed, 1e-6);
 }
 
 TEST(FreeSurface, PlainResetPondsTheTopOfACapillaryColumn)
 {
 	double error = 0, speed = 0;
+	// ponded to the top the rise is the whole suction range, 1; halfway marks the failure to hold it
 	EXPECT_GT(suctionColumnBasePressureRise(false, &error, &speed), 0.5);
 }
 

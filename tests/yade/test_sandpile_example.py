@@ -55,5 +55,7 @@ def test_upstream_pore_pressure_follows_the_rising_head(quick_run):
     after = rows[-1][key]
     g = sum(c * c for c in summary["gravity_m_per_s2"]) ** 0.5
     rise = scene["water_density"] * g * (scene["head_end"] - scene["head_start"])
-    # 5 cm from the inflow face the pressure rises by a good part of γw ΔH (measured 39%)
-    assert after - before > 0.25 * rise
+    # 5 cm from the inflow face the pressure follows the head (measured 61% of γw ΔH; 100% would be
+    # hydrostatic behind the face). While the crest acted as ponded water it rose by only 39%:
+    # more than half tells the suction-holding surface is doing its job.
+    assert after - before > 0.5 * rise
