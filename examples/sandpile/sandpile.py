@@ -4,8 +4,8 @@ Run:  yade-double -n -x examples/sandpile/sandpile.py [--quick] [--out DIR]
       (or /usr/bin/python3 examples/sandpile/sandpile.py ...)
 
 The scene (flume, pile, sand, water, head history) is yade_mpm.sandpile.DEFAULT, documented there.
-3D: the flume's front and rear walls (y = 0, width) are smooth and impermeable, the base is rough
-and impermeable, the upstream face x = 0 is a drained inflow face held at the hydrostatic profile
+3D: the flume's front and rear walls (y = 0, width) are smooth and impermeable, the base is an
+impermeable Coulomb contact (sand glued on it, δ = φ), the upstream face x = 0 is a drained inflow face held at the hydrostatic profile
 of the rising head H(t) (water enters as new water points), the pile's surface is a free surface
 that keeps the capillary suction above the phreatic line and is a seepage face (p = 0, water out,
 none in) below it, and water that seeps out of the pile is taken by the filtering cloth
@@ -84,7 +84,8 @@ engine = MpmTwoPhaseEngine(
     label="mpm", gravity=GRAVITY, domainMin=(0, 0, 0), domainMax=(SCENE.flume_length, SCENE.flume_width, SCENE.flume_height),
     cellSize=CELL, shapeFunction="uGIMP",
     #            xMin (inflow)  xMax      yMin (front)   yMax (rear)    zMin (base)    zMax
-    solidWalls=("slip",        "free",   "slip",        "slip",        "fixed",       "free"),
+    solidWalls=("slip",        "free",   "slip",        "slip",        "frictional",  "free"),
+    wallFriction=(0,           0,        0,             0,             math.tan(SCENE.base_friction_angle), 0),
     waterWalls=("drained",     "free",   "impermeable", "impermeable", "impermeable", "free"),
     waterInflow=(True, False, False, False, False, False),
     drainedWaterTable=(SCENE.head_start, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE),

@@ -16,6 +16,11 @@ NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& 
 			const WallConditions& wall = bcs.walls[2 * axis + side];
 			if (wall.solid == SolidWall::Fixed) c.solid = { true, true, true };
 			else if (wall.solid == SolidWall::Slip) c.solid[axis] = true;
+			else if (wall.solid == SolidWall::Frictional) {
+				c.solid[axis]    = true;
+				c.friction[axis] = wall.friction;
+				c.inward[axis]   = side == 0 ? 1 : -1;
+			}
 			if (wall.water == WaterWall::Impermeable) c.water[axis] = true;
 		}
 	}

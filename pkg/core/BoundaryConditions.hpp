@@ -16,6 +16,7 @@ enum class SolidWall {
 	Free,  // no constraint
 	Slip,  // smooth (roller) wall: normal solid velocity 0
 	Fixed, // rough rigid wall: all solid velocity components 0
+	Frictional, // contact: pushes (never pulls) the grains, tangential sliding resisted by Coulomb friction μ N' (theory.md eq. 2.6)
 };
 
 enum class WaterWall {
@@ -29,6 +30,7 @@ struct WallConditions {
 	SolidWall solid           = SolidWall::Free;
 	WaterWall water           = WaterWall::Free;
 	Real      drainedPressure = 0; // uniform part of p̄ on a Drained face [Pa]
+	Real      friction        = 0; // μ [-], ≥ 0: Coulomb friction coefficient of a Frictional wall
 	// Elevation of a free water surface [m] adding the hydrostatic part ρw |g| max(0, waterTable − z)
 	// to p̄ (z: elevation against gravity); the default −∞ adds nothing.
 	Real waterTable = -std::numeric_limits<Real>::infinity();
@@ -62,7 +64,12 @@ struct BoundaryConditions {
 struct NodeConstraint {
 	std::array<bool, 3> solid { false, false, false };
 	std::array<bool, 3> water { false, false, false };
+	// per axis: μ of a Frictional wall normal to that axis at this node (0: none), and the sign of
+	// its inward normal (+1 on a lower wall, −1 on an upper one)
+	std::array<Real, 3> friction { 0, 0, 0 };
+	std::array<int, 3>  inward { 0, 0, 0 };
 	bool                any() const { return solid[0] || solid[1] || solid[2] || water[0] || water[1] || water[2]; }
+	bool                contact() const { return inward[0] != 0 || inward[1] != 0 || inward[2] != 0; }
 };
 
 // Constraint of node (i, j, k) under the given walls.

@@ -82,6 +82,7 @@ ConstrainedNodes ConstrainedNodes::build(const GridGeometry& grid, const Boundar
 			for (int i = 0; i < grid.nodes[0]; ++i) {
 				const NodeConstraint c = constraintAt(grid, bcs, i, j, k);
 				if (!c.any()) continue;
+				if (c.contact()) out.contact.push_back(out.node.size());
 				out.node.push_back(grid.index(i, j, k));
 				out.constraint.push_back(c);
 			}
@@ -251,14 +252,39 @@ namespace stages {
 			Vec3&      vwNew = fields.waterVelocityNew[i];
 			const Vec3 fm = s.mixtureForce + w.pressureForce + w.weight, fw = w.porousForce + w.weight;
 			const bool holding = hasS && hasW && suctionHolding && (*suctionHolding)[i];
+			// A frictional wall is a contact (theory.md eq. 2.6): it pushes the grains with the
+			// effective normal force N' = −n̂·f', f' the effective-stress force plus the buoyant
+			// weight of the node's grains (their weight less Archimedes' share of the water weight,
+			// (1−n)/n of it), and lets them go where N' ≤ 0 (lift-off: no normal constraint, no
+			// friction). The mapped momentum is left out of N': at a held wall node it is the
+			// interior's velocity smeared onto the wall by the mapping, not an impact.
+			NodeConstraint active = nc;
+			std::array<Real, 3> normalForce { 0, 0, 0 };
+			if (hasS)
+				for (int d = 0; d < 3; ++d) {
+					if (nc.inward[d] == 0) continue;
+					const Real n          = hasW ? fields.porosity[i] : 1; // porosity is mapped only in wet scenes
+					const Real solidForce = hasW && n > 0 ? s.mixtureForce[d] - ((1 - n) / n) * w.weight[d] : s.mixtureForce[d];
+					normalForce[d]        = -nc.inward[d] * solidForce;
+					active.solid[d]       = normalForce[d] > 0;
+				}
 			for (int d = 0; d < 3; ++d) {
-				if (nc.solid[d] || (holding && nc.water[d])) vsNew[d] = 0;
-				if (nc.water[d] || (holding && nc.solid[d])) vwNew[d] = 0;
-				if (!(hasS && hasW) || holding || nc.solid[d] == nc.water[d]) continue;
+				if (active.solid[d] || (holding && active.water[d])) vsNew[d] = 0;
+				if (active.water[d] || (holding && active.solid[d])) vwNew[d] = 0;
+				if (!(hasS && hasW) || holding || active.solid[d] == active.water[d]) continue;
 				const Real ms = s.mass, mw = w.mass, Q = s.drag, A = mw / dt;
 				const Real vs = fields.solidVelocity[i][d], vw = fields.waterVelocity[i][d];
-				if (nc.solid[d]) vwNew[d] = drag == DragScheme::SemiImplicit ? (A * vw + fw[d]) / (A + Q) : vw + (dt / mw) * (fw[d] - Q * (vw - vs));
+				if (active.solid[d]) vwNew[d] = drag == DragScheme::SemiImplicit ? (A * vw + fw[d]) / (A + Q) : vw + (dt / mw) * (fw[d] - Q * (vw - vs));
 				else vsNew[d] = vs + (dt * fm[d] - mw * (vwNew[d] - vw)) / ms;
+			}
+			// Coulomb: the tangential impulse is at most μ N' Δt; the solid sticks below it and slides
+			// slower above it. Components held by other walls are zero already.
+			for (int d = 0; d < 3; ++d) {
+				if (!(hasS && active.solid[d] && nc.friction[d] > 0)) continue;
+				Vec3 tangential = vsNew;
+				tangential[d]   = 0;
+				const Real speed = tangential.norm(), limit = nc.friction[d] * normalForce[d] * dt / s.mass;
+				vsNew -= speed <= limit ? tangential : Vec3((limit / speed) * tangential);
 			}
 		}
 	}
@@ -292,6 +318,12 @@ namespace stages {
 	                     Real massTolerance, const ConstrainedNodes& constrained, bool solidPhase, std::vector<Vec3>& remapped,
 	                     std::vector<std::vector<Vec3>>& workspace)
 	{
+		// Contact (frictional) wall nodes keep the velocity the contact gave them (eq. 2.6): the
+		// points next to a wall carry the interior's velocity, and remapping them would undo a
+		// stick, so the strain rate at the wall would never see the friction.
+		std::vector<Vec3> contactVelocity;
+		if (solidPhase)
+			for (std::size_t c : constrained.contact) contactVelocity.push_back(remapped[constrained.node[c]]);
 		std::fill(remapped.begin(), remapped.end(), Vec3::Zero());
 		// momenta only: accumulate Σ S m v into `remapped`, then divide by the (unchanged) nodal mass
 		for (const MaterialPointSet* set : sets) {
@@ -308,6 +340,7 @@ namespace stages {
 		for (std::size_t i = 0; i < count; ++i) remapped[i] = nodes[i].mass > massTolerance ? Vec3(remapped[i] / nodes[i].mass) : Vec3::Zero();
 		for (std::size_t c = 0; c < constrained.node.size(); ++c)
 			applyConstraint(solidPhase ? constrained.constraint[c].solid : constrained.constraint[c].water, remapped[constrained.node[c]]);
+		for (std::size_t f = 0; f < contactVelocity.size(); ++f) remapped[constrained.node[constrained.contact[f]]] = contactVelocity[f];
 	}
 
 	template <class Kernel>

@@ -53,6 +53,7 @@ struct ScatterWorkspace {
 struct ConstrainedNodes {
 	std::vector<std::size_t>    node;
 	std::vector<NodeConstraint> constraint;
+	std::vector<std::size_t>    contact; // positions in node/constraint of nodes on a frictional (contact) wall
 	static ConstrainedNodes     build(const GridGeometry& grid, const BoundaryConditions& bcs);
 };
 

@@ -33,8 +33,8 @@ namespace {
 	};
 	const std::array<std::pair<const char*, mpm::DragScheme>, 2> dragOptions { { { "semi-implicit", mpm::DragScheme::SemiImplicit },
 		                                                                       { "explicit", mpm::DragScheme::Explicit } } };
-	const std::array<std::pair<const char*, mpm::SolidWall>, 3> solidWallOptions {
-		{ { "free", mpm::SolidWall::Free }, { "slip", mpm::SolidWall::Slip }, { "fixed", mpm::SolidWall::Fixed } }
+	const std::array<std::pair<const char*, mpm::SolidWall>, 4> solidWallOptions {
+		{ { "free", mpm::SolidWall::Free }, { "slip", mpm::SolidWall::Slip }, { "fixed", mpm::SolidWall::Fixed }, { "frictional", mpm::SolidWall::Frictional } }
 	};
 	const std::array<std::pair<const char*, mpm::WaterWall>, 3> waterWallOptions {
 		{ { "free", mpm::WaterWall::Free }, { "impermeable", mpm::WaterWall::Impermeable }, { "drained", mpm::WaterWall::Drained } }
@@ -59,6 +59,8 @@ mpm::Domain MpmTwoPhaseEngine::domain() const
 		wall.solid           = parseOption("solidWalls[" + std::string(faceNames[f]) + "]", solidWalls[f], solidWallOptions);
 		wall.water           = parseOption("waterWalls[" + std::string(faceNames[f]) + "]", waterWalls[f], waterWallOptions);
 		wall.drainedPressure = drainedPressure[f];
+		wall.friction        = wallFriction[f];
+		if (!(wall.friction >= 0 && std::isfinite(wall.friction))) mpm::throwOutOfRange("wallFriction[" + std::string(faceNames[f]) + "]", wall.friction, "", "[0, inf)");
 		wall.waterTable      = drainedWaterTable[f];
 		wall.inflow          = waterInflow[f] != 0;
 		if (wall.inflow && wall.water != mpm::WaterWall::Drained)
@@ -149,7 +151,7 @@ void MpmTwoPhaseEngine::action()
 MpmTwoPhaseEngine::Structure MpmTwoPhaseEngine::structure() const
 {
 	return Structure { gravity,       timeStepFactor, flipBlend,  domainMin,  domainMax,  cellSize,               shapeFunction, drag,
-		           cellAveraging, pressureModeDamping, freeSurfaceThreshold, freeSurfaceHoldsSuction, solidWalls, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow };
+		           cellAveraging, pressureModeDamping, freeSurfaceThreshold, freeSurfaceHoldsSuction, solidWalls, wallFriction, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow };
 }
 
 void MpmTwoPhaseEngine::callPostLoad()
@@ -191,7 +193,9 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		         "Free-surface detection β [-], 0 ≤ β < 1: water points whose filling Σ S V_water/V_full of their nodes is below β get p = 0 (0.75 keeps exactly the outer layer with 2 points per cell and axis); 0: off"),
 		boolAttr("freeSurfaceHoldsSuction", &E::freeSurfaceHoldsSuction,
 		         "With a free surface (freeSurfaceThreshold > 0): the surface keeps suction (p < 0), as capillary menisci hold the water to the grains there (no relative flow at its nodes), and releases only positive pressure, p = min(p, 0): a seepage face that lets water out but draws none in. False: p = 0 on every free-surface point, as under ponded water [-]"),
-		fixedListAttr("solidWalls", &E::solidWalls, 6, "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0) or 'fixed'"),
+		fixedListAttr("solidWalls", &E::solidWalls, 6,
+		              "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0), 'fixed' or 'frictional' (normal velocity 0, Coulomb friction wallFriction on the effective normal force)"),
+		fixedListAttr("wallFriction", &E::wallFriction, 6, "Coulomb friction coefficient μ = tan δ per 'frictional' face [-], ≥ 0"),
 		fixedListAttr("waterWalls", &E::waterWalls, 6, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
 		fixedListAttr("drainedPressure", &E::drainedPressure, 6, "Uniform part of the pore pressure p̄ held on each 'drained' face [Pa]"),
 		AttrSpec<E> { "waterSinks", "Boxes in which water points are removed (outflow, e.g. a filtering cloth), as a list of (lower, upper) corner pairs [m]",
@@ -270,6 +274,7 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& BOOST_SERIALIZATION_NVP(solidWalls);
 	ar& BOOST_SERIALIZATION_NVP(waterWalls);
 	ar& BOOST_SERIALIZATION_NVP(drainedPressure);
+	ar& BOOST_SERIALIZATION_NVP(wallFriction);
 	ar& BOOST_SERIALIZATION_NVP(drainedWaterTable);
 	serializeFlat(ar, "waterSinks", waterSinks);
 	ar& BOOST_SERIALIZATION_NVP(removeWaterLeavingGrid);

@@ -32,6 +32,7 @@ public:
 	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed
 	std::vector<std::string> waterWalls { 6, "free" };      // free | impermeable | drained
 	std::vector<yade::Real>  drainedPressure = std::vector<yade::Real>(6, 0.0); // p̄ per face [Pa]
+	std::vector<yade::Real>  wallFriction    = std::vector<yade::Real>(6, 0.0); // μ per 'frictional' face [-]
 	std::vector<yade::Vector3r> waterSinks;             // (lower, upper) corner pairs of sink boxes [m]
 	bool                        removeWaterLeavingGrid = true; // water leaving the grid is removed (else: stop)
 	bool                        removeFreeWater        = false; // water points with no solid in their stencil are removed
@@ -68,7 +69,7 @@ private:
 	// Everything the solver is built from except the values held on drained faces, which a
 	// running solver takes over in place (a rising head set every step must not rebuild it).
 	using Structure = std::tuple<yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, bool, yade::Real, bool,
-	                             std::vector<std::string>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>>;
+	                             std::vector<std::string>, std::vector<yade::Real>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>>;
 	Structure structure() const;
 
 	std::unique_ptr<mpm::TwoPhaseSolver> solver_;  // not serialized: rebuilt on first action()

@@ -9,6 +9,7 @@ the values below are documented lab-scale choices, not the paper's:
   slope and a vertical upstream face against the inflow reservoir at x = 0;
 * dense quartz sand: ρs = 2650 kg m⁻³, n = 0.40, E = 20 MPa, ν = 0.3, φ = 36°, ψ = 6°, c = 0,
   friction softening to 30° over κ_s = 0.05; k = 1e-3 m s⁻¹ (medium sand);
+* flume base roughened with glued sand: a Coulomb contact with δ = φ = 36°;
 * water: ρw = 1000 kg m⁻³, μw = 1e-3 Pa s, Kw lowered to 2.2e8 Pa for speed: Kw/n = 20 E_oed keeps
   the water nearly incompressible for this quasi-static seepage (the formulation asks ≥ 10–100);
 * the pile starts saturated throughout, at rest: hydrostatic below the inflow level 0.03 m and held
@@ -43,6 +44,7 @@ class SandPileScene:
     dilatancy_angle: float = math.radians(6)          # ψ [rad]
     residual_friction_angle: float = math.radians(30)  # φ_r [rad]
     softening_strain: float = 0.05   # κ_s [-]
+    base_friction_angle: float = math.radians(36)  # δ [rad] of the flume base (sand glued on it: δ = φ)
     hydraulic_conductivity: float = 1e-3  # k [m s⁻¹]
     water_density: float = 1000.0    # ρw [kg m⁻³]
     water_viscosity: float = 1e-3    # μw [Pa s]
@@ -83,6 +85,8 @@ class SandPileScene:
             raise ValueError("the pile's toe x = %.3f m lies beyond the flume length %.3f m" % (self.toe_x(), self.flume_length))
         if not (0 <= self.head_start <= self.head_end <= self.pile_height):
             raise ValueError("heads must satisfy 0 ≤ head_start ≤ head_end ≤ pile_height; got %r, %r, %r m" % (self.head_start, self.head_end, self.pile_height))
+        if not (0 <= self.base_friction_angle < math.pi / 2):
+            raise ValueError("base_friction_angle = %r rad is outside the valid range [0, π/2)" % self.base_friction_angle)
         if self.pile_height >= self.flume_height:
             raise ValueError("pile_height = %r m must be below flume_height = %r m" % (self.pile_height, self.flume_height))
 

@@ -59,6 +59,23 @@ def test_bad_point_data_stops_before_any_work_with_a_clear_message():
     assert O.engines[0].stepsDone == 0 and O.engines[0].mpmTime == 0
 
 
+@pytest.mark.parametrize("friction", [-0.1, float("nan"), float("inf")])
+def test_bad_wall_friction_stops_before_any_work_with_a_clear_message(friction):
+    soil, water = w.MpmSoilMat(), w.MpmWaterMat()
+    O.materials.append([soil, water])
+    O.bodies.append(list(yade_mpm.saturated_block((0, 0, 0), (0.1, 0.1, 0.1), 0.05, soil, water, points_per_cell=2)))
+    message = r"wallFriction\[zMin\] = %s is outside the valid range \[0, inf\)" % ("-0.1" if friction < 0 else "(nan|inf)")
+    with pytest.raises(ValueError, match=message):  # at construction
+        w.MpmTwoPhaseEngine(solidWalls=("slip",) * 4 + ("frictional", "free"), wallFriction=(0, 0, 0, 0, friction, 0))
+    engine = w.MpmTwoPhaseEngine(label="mpm", solidWalls=("slip",) * 4 + ("frictional", "free"))
+    with pytest.raises(ValueError, match=message):  # when set (the value stays, as in YADE's own classes)
+        engine.wallFriction = (0, 0, 0, 0, friction, 0)
+    O.engines = [engine]
+    with pytest.raises(ValueError, match=message):  # and every step refuses it before any work
+        O.step()
+    assert engine.stepsDone == 0 and engine.mpmTime == 0
+
+
 def test_saturated_block_geostatic_state():
     """Pore pressure ρw g d and vertical effective stress −(ρsat−ρw) g d at depth d; masses exact."""
     g = 9.81

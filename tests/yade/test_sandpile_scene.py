@@ -37,3 +37,9 @@ def test_water_stays_nearly_incompressible():
 def test_invalid_scene_is_refused():
     with pytest.raises(ValueError, match="toe"):
         sandpile.pile_points(sandpile.SandPileScene(flume_length=0.2), 0.01)
+
+
+@pytest.mark.parametrize("angle", [-0.1, math.pi / 2])
+def test_base_friction_angle_out_of_range_is_refused(angle):
+    with pytest.raises(ValueError, match=r"base_friction_angle = .* is outside the valid range \[0, π/2\)"):
+        sandpile.pile_points(sandpile.SandPileScene(base_friction_angle=angle), 0.01)
