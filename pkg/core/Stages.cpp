@@ -255,8 +255,8 @@ namespace stages {
 			// A frictional wall is a contact (theory.md eq. 2.6): it pushes the grains with the
 			// effective normal force N' = −n̂·f', f' the effective-stress force plus the buoyant
 			// weight of the node's grains (their weight less Archimedes' share of the water weight,
-			// (1−n)/n of it), and lets them go where N' ≤ 0 (lift-off: no normal constraint, no
-			// friction). The mapped momentum is left out of N': at a held wall node it is the
+			// (1−n)/n of it), and lets them go where N' ≤ 0 and they move off the wall (lift-off:
+			// no normal constraint, no friction). The mapped momentum is left out of N': at a held wall node it is the
 			// interior's velocity smeared onto the wall by the mapping, not an impact.
 			NodeConstraint active = nc;
 			std::array<Real, 3> normalForce { 0, 0, 0 };
@@ -266,7 +266,10 @@ namespace stages {
 					const Real n          = hasW ? fields.porosity[i] : 1; // porosity is mapped only in wet scenes
 					const Real solidForce = hasW && n > 0 ? s.mixtureForce[d] - ((1 - n) / n) * w.weight[d] : s.mixtureForce[d];
 					normalForce[d]        = -nc.inward[d] * solidForce;
-					active.solid[d]       = normalForce[d] > 0;
+					// released only when pulled off and moving off: a node pulled off but carried
+					// towards the wall by its momentum stays held (else it would pass the wall)
+					active.solid[d] = normalForce[d] > 0 || nc.inward[d] * vsNew[d] < 0;
+					normalForce[d]  = std::max<Real>(0, normalForce[d]);
 				}
 			for (int d = 0; d < 3; ++d) {
 				if (active.solid[d] || (holding && active.water[d])) vsNew[d] = 0;
