@@ -9,13 +9,16 @@ NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& 
 {
 	NodeConstraint  c;
 	const int       idx[3] = { i, j, k };
+	bool            onFixedWall = false;
 	for (int axis = 0; axis < 3; ++axis) {
 		for (int side = 0; side < 2; ++side) {
 			const bool onOrBeyond = side == 0 ? idx[axis] <= grid.wallNode[axis] : idx[axis] >= grid.upperWallNode[axis];
 			if (!onOrBeyond) continue;
 			const WallConditions& wall = bcs.walls[2 * axis + side];
-			if (wall.solid == SolidWall::Fixed) c.solid = { true, true, true };
-			else if (wall.solid == SolidWall::Slip) c.solid[axis] = true;
+			if (wall.solid == SolidWall::Fixed) {
+				c.solid     = { true, true, true };
+				onFixedWall = true;
+			} else if (wall.solid == SolidWall::Slip) c.solid[axis] = true;
 			else if (wall.solid == SolidWall::Frictional) {
 				c.solid[axis]    = true;
 				c.friction[axis] = wall.friction;
@@ -23,6 +26,12 @@ NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& 
 			}
 			if (wall.water == WaterWall::Impermeable) c.water[axis] = true;
 		}
+	}
+	// On an edge where a fixed wall meets a frictional one, the fixed wall holds the node for good:
+	// no contact that could release it
+	if (onFixedWall) {
+		c.friction = { 0, 0, 0 };
+		c.inward   = { 0, 0, 0 };
 	}
 	return c;
 }

@@ -256,8 +256,9 @@ namespace stages {
 			// effective normal force N' = −n̂·f', f' the effective-stress force plus the buoyant
 			// weight of the node's grains (their weight less Archimedes' share of the water weight,
 			// (1−n)/n of it), and lets them go where N' ≤ 0 and they move off the wall (lift-off:
-			// no normal constraint, no friction). The mapped momentum is left out of N': at a held wall node it is the
-			// interior's velocity smeared onto the wall by the mapping, not an impact.
+			// no normal constraint, no friction). The mapped momentum is left out of N': at a held
+			// wall node it is the interior's velocity smeared onto the wall by the mapping, not an
+			// impact.
 			NodeConstraint active = nc;
 			std::array<Real, 3> normalForce { 0, 0, 0 };
 			if (hasS)

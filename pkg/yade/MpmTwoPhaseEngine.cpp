@@ -194,7 +194,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		boolAttr("freeSurfaceHoldsSuction", &E::freeSurfaceHoldsSuction,
 		         "With a free surface (freeSurfaceThreshold > 0): the surface keeps suction (p < 0), as capillary menisci hold the water to the grains there (no relative flow at its nodes), and releases only positive pressure, p = min(p, 0): a seepage face that lets water out but draws none in. False: p = 0 on every free-surface point, as under ponded water [-]"),
 		fixedListAttr("solidWalls", &E::solidWalls, 6,
-		              "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0), 'fixed' or 'frictional' (normal velocity 0, Coulomb friction wallFriction on the effective normal force)"),
+		              "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0), 'fixed' or 'frictional' (a contact: pushes the grains, never pulls them, and resists sliding by Coulomb friction wallFriction × the effective normal force; a fixed wall wins on a shared edge)"),
 		fixedListAttr("wallFriction", &E::wallFriction, 6, "Coulomb friction coefficient μ = tan δ per 'frictional' face [-], ≥ 0"),
 		fixedListAttr("waterWalls", &E::waterWalls, 6, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
 		fixedListAttr("drainedPressure", &E::drainedPressure, 6, "Uniform part of the pore pressure p̄ held on each 'drained' face [Pa]"),

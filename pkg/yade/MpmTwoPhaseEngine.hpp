@@ -29,7 +29,7 @@ public:
 	bool           pressureModeDamping = true;              // grid-invisible pressure modes decay (theory.md eq. 4.17b)
 	yade::Real     freeSurfaceThreshold = 0;                // β [-]: p = 0 on water points filled below β; 0 off
 	bool           freeSurfaceHoldsSuction = false;         // the free surface keeps suction, releases only p > 0 (seepage face)
-	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed
+	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed | frictional
 	std::vector<std::string> waterWalls { 6, "free" };      // free | impermeable | drained
 	std::vector<yade::Real>  drainedPressure = std::vector<yade::Real>(6, 0.0); // p̄ per face [Pa]
 	std::vector<yade::Real>  wallFriction    = std::vector<yade::Real>(6, 0.0); // μ per 'frictional' face [-]

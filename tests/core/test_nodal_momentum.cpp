@@ -108,4 +108,42 @@ TEST(Walls, HeldSolidComponentReSolvesTheWaterWithDragToIt)
 	EXPECT_LT((fields.waterVelocityNew[I] - expected).norm(), 1e-14);
 }
 
+// A dry node on a frictional base (eq. 2.6): mass m, old velocity v, force f; returns the new velocity.
+Vec3 contactUpdate(const Vec3& v, const Vec3& f, Real mu, SolidWall sideWall = SolidWall::Free)
+{
+	GridGeometry       g = GridGeometry::forDomain(Vec3::Zero(), Vec3::Ones(), 1.0);
+	BoundaryConditions bcs;
+	bcs.walls[static_cast<int>(Face::ZMin)]          = { SolidWall::Frictional, WaterWall::Free };
+	bcs.walls[static_cast<int>(Face::ZMin)].friction = mu;
+	bcs.walls[static_cast<int>(Face::XMin)]          = { sideWall, WaterWall::Free };
+	ConstrainedNodes c = ConstrainedNodes::build(g, bcs);
+	GridFields       fields;
+	fields.resize(g.nodeCount());
+	const std::size_t I     = g.index(1, 1, 1); // on the base, and on the xMin wall
+	const Real        m     = 2;
+	fields.solid[I]         = SolidNode { m, m * v, f, 1, 0.6, 0 };
+	fields.solidVelocity[I] = v;
+	stages::integrateNodalMomentum(fields, c, 0.1, DragScheme::SemiImplicit, 1e-12, 1e-12);
+	return fields.solidVelocityNew[I];
+}
+
+TEST(FrictionalWall, PressedNodeSlidesWithTheCoulombImpulseOrSticks)
+{
+	// N' = 10 N into the base; trial tangential velocity (0.3, 0.4) + 0.1/2 (6, 8) = (0.6, 0.8), |v_t| = 1
+	const Vec3 v(0.3, 0.4, 0), f(6, 8, -10);
+	const Vec3 sliding = contactUpdate(v, f, 0.5); // μ N' Δt/m = 0.25: |v_t| 1 → 0.75, same direction
+	EXPECT_LT((sliding - Vec3(0.45, 0.6, 0)).norm(), 1e-14);
+	EXPECT_TRUE(contactUpdate(v, f, 2.5).isZero()); // μ N' Δt/m = 1.25 ≥ |v_t|: sticks
+}
+
+TEST(FrictionalWall, LetsGoOnlyWhatIsPulledOffAndMovesOff)
+{
+	const Vec3 pulledOff = contactUpdate(Vec3(0.1, 0, 0.2), Vec3(0, 0, 4), 0.5); // free: v + Δt f/m, no friction
+	EXPECT_LT((pulledOff - Vec3(0.1, 0, 0.4)).norm(), 1e-14);
+	const Vec3 approaching = contactUpdate(Vec3(0.1, 0, -0.5), Vec3(0, 0, 4), 0.5); // v_z + Δt f_z/m = −0.3: held
+	EXPECT_LT((approaching - Vec3(0.1, 0, 0)).norm(), 1e-14);                     // N' = 0: no friction either
+	// on the edge with a fixed wall the node is held for good, whatever pulls it
+	EXPECT_TRUE(contactUpdate(Vec3(0.1, 0, 0.2), Vec3(0, 0, 4), 0.5, SolidWall::Fixed).isZero());
+}
+
 } // namespace
