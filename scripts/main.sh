@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The main job: install, build, and run the built-in default scene in YADE: the oedometer
-# (Terzaghi consolidation) in quick mode. Writes examples/oedometer/out/isochrones.png and
-# summary.json and prints the summary.
+# The main job: install, build, and run the built-in default scene in YADE: the saturated sand
+# pile (yade_mpm.sandpile.DEFAULT) in quick mode, about 4–5 min on 2 cores. Writes
+# examples/sandpile/out-quick/ (HDF5/XDMF, figures, time series, summary.json) and prints the
+# summary: failure head and time, sliding surface, water mass balance.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/build.sh"
 cd "$root"
-yade-double -n -x examples/oedometer/oedometer.py --quick
+yade-double -j2 -n -x examples/sandpile/sandpile.py --quick

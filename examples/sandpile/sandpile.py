@@ -19,7 +19,7 @@ Writes to DIR (default examples/sandpile/out[-quick]):
   pore_pressure.png               pore pressure at four times (x–z view)
   velocity_at_failure.png         solid velocity field at failure
   shear_band.png                  plastic shear strain with the extracted sliding surface
-  time_series.png                 head, pore pressure at probes, toe displacement
+  time_series.png                 head, pore pressure at probes, slope-face and toe displacement
   time_series.csv                 the same numbers
   summary.json                    failure head and time, sliding surface, mass balance, run time
 The water mass balance (initial + injected = stored + removed) is checked at every record; the run
@@ -54,8 +54,10 @@ DURATION = args.duration or SCENE.duration()  # [s]
 OUT = args.out or os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "out-quick" if args.quick else "out")
 RECORD_INTERVAL = 0.01  # time between time-series samples [s]
 FIELD_INTERVAL = 0.05   # time between HDF5 frames [s]
-FAILURE_DISPLACEMENT = 0.02 * SCENE.pile_height  # toe displacement that marks failure [m]
-MOVING_DISPLACEMENT = 0.25 * CELL  # displacement that marks a point as part of the sliding mass [m]
+FAILURE_DISPLACEMENT = 0.01 * SCENE.pile_height  # mean displacement of the lower slope face that marks failure [m]
+# plastic shear strain that marks a point as part of the shear band: ten softening scales, where the
+# sand has reached its critical state (φ within e⁻¹⁰ of φ_r) [-]
+BAND_STRAIN = 10 * SCENE.softening_strain
 BALANCE_TOLERANCE = 1e-9  # relative water mass balance residual that stops the run [-]
 if not 0 < CELL <= SCENE.pile_height / 4:
     raise ValueError("--cell = %r m is outside the valid range (0, %g] (at least 4 cells over the pile height)" % (CELL, SCENE.pile_height / 4))
@@ -108,6 +110,10 @@ PROBES = {"upstream x=0.05": (0.05, 0.5 * SCENE.flume_width, 0.02),
           "near toe x=0.27": (0.27, 0.5 * SCENE.flume_width, 0.01)}
 # the toe region: solid points within two cells of the toe along the base
 toe_points = np.flatnonzero((start_positions[:, 0] > toe - 2 * CELL) & (start_positions[:, 2] < 2 * CELL))
+# the lower slope face, where seepage exits and the slide starts: solid points within two cells of
+# the downstream surface, below mid-height
+face_points = np.flatnonzero((start_positions[:, 0] > SCENE.crest_length) & (start_positions[:, 2] < 0.5 * SCENE.pile_height)
+                             & (SCENE.surface_height(start_positions[:, 0]) - start_positions[:, 2] < 2 * CELL))
 
 
 def probe_pressure(location):
@@ -119,6 +125,11 @@ def probe_pressure(location):
 def toe_displacement():
     """Mean horizontal displacement [m] of the toe region's solid points."""
     return float((solid.pos[toe_points, 0] - start_positions[toe_points, 0]).mean())
+
+
+def face_displacement():
+    """Mean displacement magnitude [m] of the lower slope face's solid points."""
+    return float(np.linalg.norm(solid.pos[face_points] - start_positions[face_points], axis=1).mean())
 
 
 initial_water = float(fluid.mass.sum())
@@ -152,7 +163,7 @@ while O.time < DURATION - 1e-12:
         raise RuntimeError("water mass balance failed at t = %.4f s: (stored + removed − initial − injected)/initial = %.3e"
                            % (O.time, residual))
     speed = np.linalg.norm(solid.vel, axis=1)
-    row = {"time_s": O.time, "head_m": SCENE.head(O.time), "toe_displacement_m": toe_displacement(),
+    row = {"time_s": O.time, "head_m": SCENE.head(O.time), "toe_displacement_m": toe_displacement(), "face_displacement_m": face_displacement(),
            "max_solid_speed_m_per_s": float(speed.max()), "water_points": fluid.count, "injected_kg": engine.injectedWaterMass,
            "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual}
     row.update({"p_%s_Pa" % name.split()[0] + "_" + name.split()[1]: probe_pressure(loc) for name, loc in PROBES.items()})
@@ -160,24 +171,25 @@ while O.time < DURATION - 1e-12:
     if settled is None and O.time >= SCENE.settle_time - 1e-9:
         settled = dict(row)
         snapshots["end of settling"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
-    if failure is None and row["toe_displacement_m"] > FAILURE_DISPLACEMENT:
+    if failure is None and row["face_displacement_m"] > FAILURE_DISPLACEMENT:
         failure = dict(row)
         snapshots["failure"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
         failure_state = (solid.pos.copy(), solid.vel.copy())
     mid = SCENE.settle_time + 0.5 * SCENE.head_ramp_time
     if "mid rise" not in snapshots and O.time >= mid - 1e-9:
         snapshots["mid rise"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
-    print("t = %.3f s  head %.4f m  toe %.2e m  max |v_s| %.2e m/s  water points %d  balance %.1e  (%.0f s)"
-          % (O.time, row["head_m"], row["toe_displacement_m"], row["max_solid_speed_m_per_s"], fluid.count, residual, time.time() - wall_start),
+    print("t = %.3f s  head %.4f m  toe %.2e m  face %.2e m  max |v_s| %.2e m/s  water points %d  balance %.1e  (%.0f s)"
+          % (O.time, row["head_m"], row["toe_displacement_m"], row["face_displacement_m"], row["max_solid_speed_m_per_s"], fluid.count, residual, time.time() - wall_start),
           flush=True)
 run_time = time.time() - wall_start
 snapshots["end"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
 if failure is None:
     failure_state = (solid.pos.copy(), solid.vel.copy())
 
-# --- sliding surface: the base of the mass that moved ---------------------------------------------
-displacement = np.linalg.norm(solid.pos - start_positions, axis=1)
-moving = displacement > MOVING_DISPLACEMENT
+# --- sliding surface: the base of the shear band --------------------------------------------------
+# (from κ, not from the displacement: at failure the slide has moved millimetres, while the band
+# where the sand has softened to its critical state is already complete)
+moving = solid.plasticShearStrain > BAND_STRAIN
 x0, z0 = start_positions[:, 0], start_positions[:, 2]
 bins = np.arange(0, toe + CELL, spacing)
 surface_x, surface_z = [], []
@@ -185,7 +197,7 @@ for lo in bins:
     column = (x0 >= lo) & (x0 < lo + spacing)
     if not (column & moving).any():
         continue
-    # the sliding surface lies under the lowest moving point of the column (undeformed positions)
+    # the sliding surface lies under the lowest band point of the column (undeformed positions)
     surface_x.append(lo + 0.5 * spacing)
     surface_z.append(float(z0[column & moving].min()) - 0.5 * spacing)
 surface_x, surface_z = np.array(surface_x), np.array(surface_z)
@@ -195,7 +207,7 @@ if len(surface_x):
     sliding = {"scarp_x_m": float(surface_x.min()), "exit_x_m": float(surface_x.max()),
                "lowest_z_m": float(surface_z.min()), "max_depth_below_surface_m": float(depth.max()),
                "exit_z_m": float(surface_z[np.argmax(surface_x)]),
-               "moving_volume_fraction": float(moving.mean()),
+               "band_volume_fraction": float(moving.mean()), "band_strain": BAND_STRAIN,
                "passes_through_toe_region": bool(abs(surface_x.max() - toe) <= 2 * CELL and surface_z[np.argmax(surface_x)] <= 2 * CELL)}
 
 stored, residual = mass_balance()
@@ -211,9 +223,11 @@ summary = {
     "run_time_s": run_time,
     "threads": int(O.numThreads),
     "stable_before_rise": {"toe_displacement_m": settled["toe_displacement_m"] if settled else None,
+                           "face_displacement_m": settled["face_displacement_m"] if settled else None,
                            "max_solid_speed_m_per_s": settled["max_solid_speed_m_per_s"] if settled else None},
     "failure": None if failure is None else {"time_s": failure["time_s"], "head_m": failure["head_m"],
-                                              "criterion": "toe displacement > %.4f m" % FAILURE_DISPLACEMENT},
+                                              "face_displacement_m": failure["face_displacement_m"],
+                                              "criterion": "mean displacement of the lower slope face > %.4f m" % FAILURE_DISPLACEMENT},
     "sliding_surface": sliding,
     "water_mass_balance": {"initial_kg": initial_water, "injected_kg": engine.injectedWaterMass, "removed_kg": engine.removedWaterMass,
                            "stored_kg": stored, "relative_residual": residual},
@@ -272,7 +286,7 @@ kappa = solid.plasticShearStrain
 sc = ax.scatter(start_positions[:, 0], start_positions[:, 2], c=kappa, s=6, cmap="magma_r", vmin=0, vmax=max(np.percentile(kappa, 99), 1e-6))
 fig.colorbar(sc, ax=ax, label="κ, plastic shear strain [-]")
 if len(surface_x):
-    ax.plot(surface_x, surface_z, "c-", lw=2, label="sliding surface (base of the moved mass)")
+    ax.plot(surface_x, surface_z, "c-", lw=2, label="sliding surface (base of the band κ > %.2f)" % BAND_STRAIN)
     ax.legend(fontsize=8, loc="upper right")
 frame(ax, "plastic shear strain at t = %.2f s on the undeformed pile" % O.time)
 fig.tight_layout()
@@ -287,9 +301,10 @@ for key in rows[0]:
         a2.plot(t, [r[key] for r in rows], label=key[2:-3].replace("_", " "))
 a2.set_ylabel("pore pressure [Pa]")
 a2.legend(fontsize=7)
-a3.plot(t, 1e3 * np.array([r["toe_displacement_m"] for r in rows]))
+a3.plot(t, 1e3 * np.array([r["face_displacement_m"] for r in rows]), label="lower slope face (mean |u|)")
+a3.plot(t, 1e3 * np.array([r["toe_displacement_m"] for r in rows]), label="toe region (mean u_x)")
 a3.axhline(1e3 * FAILURE_DISPLACEMENT, color="r", ls=":", label="failure criterion")
-a3.set_ylabel("toe displacement [mm]")
+a3.set_ylabel("displacement [mm]")
 a3.set_xlabel("t [s]")
 a3.legend(fontsize=7)
 if failure:

@@ -87,7 +87,7 @@ const AttrTable<MpmSoilMat>& MpmSoilMat::attributes()
 		stringAttr("model", &M::model,
 		           "Skeleton model [-]: 'linearElastic', 'DruckerPrager' (non-associated cone matched to Mohr–Coulomb in plane strain) or 'MohrCoulomb' (non-associated, principal stresses)"),
 		realAttr("frictionAngle", &M::frictionAngle, "Peak friction angle φ [rad], 0 < φ < π/2"),
-		realAttr("dilatancyAngle", &M::dilatancyAngle, "Dilatancy angle ψ [rad], 0 ≤ ψ ≤ φ"),
+		realAttr("dilatancyAngle", &M::dilatancyAngle, "Peak dilatancy angle ψ [rad], 0 ≤ ψ ≤ φ; with softening it fades with the friction, ψ(κ) = ψ (φ(κ) − φ_r)/(φ − φ_r) (theory.md eq. 7.1b)"),
 		realAttr("cohesion", &M::cohesion, "Cohesion c [Pa], ≥ 0"),
 		realAttr("tensionCutoff", &M::tensionCutoff, "Largest isotropic tension carried σ_t [Pa], ≥ 0 (the cone's apex limits it further)"),
 		realAttr("residualFrictionAngle", &M::residualFrictionAngle, "Residual friction angle φ_r reached by softening [rad], 0 < φ_r ≤ φ"),

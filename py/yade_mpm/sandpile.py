@@ -8,14 +8,16 @@ the values below are documented lab-scale choices, not the paper's:
 * flume 0.60 m long (x), 0.10 m wide (y); pile 0.12 m high with a 0.10 m crest, a 30° downstream
   slope and a vertical upstream face against the inflow reservoir at x = 0;
 * dense quartz sand: ρs = 2650 kg m⁻³, n = 0.40, E = 20 MPa, ν = 0.3, φ = 36°, ψ = 6°, c = 0,
-  friction softening to 30° over κ_s = 0.05; k = 1e-3 m s⁻¹ (medium sand);
+  friction softening to 30° (the critical state) over κ_s = 0.01, the dilatancy fading with it
+  (theory.md eq. 7.1b): a brittle dense sand, most of the softening within ~3% plastic shear
+  strain; k = 1e-3 m s⁻¹ (medium sand);
 * flume base roughened with glued sand: a Coulomb contact with δ = φ = 36°;
 * water: ρw = 1000 kg m⁻³, μw = 1e-3 Pa s, Kw lowered to 2.2e8 Pa for speed: Kw/n = 20 E_oed keeps
   the water nearly incompressible for this quasi-static seepage (the formulation asks ≥ 10–100);
 * the pile starts saturated throughout, at rest: hydrostatic below the inflow level 0.03 m and held
   by capillary suction above it (the experiment keeps the pile saturated for the same reason);
 * head at the inflow face held at 0.03 m for 0.05 s (the pile settles under gravity), then raised
-  linearly to the crest, 0.12 m, over 0.3 s, then held for 0.2 s. The laboratory raises it over
+  linearly to the crest, 0.12 m, over 0.3 s, then held for 0.25 s. The laboratory raises it over
   minutes; the ramp here is compressed because the pore pressures follow it quasi-statically
   either way: they settle in the consolidation time L² γw / (k M) ≈ 0.035 s over the 0.3 m flow
   path (M = 1/(1/E_oed + n/Kw) ≈ 26 MPa), a ninth of the ramp. What the compression does change
@@ -43,7 +45,7 @@ class SandPileScene:
     friction_angle: float = math.radians(36)          # φ [rad]
     dilatancy_angle: float = math.radians(6)          # ψ [rad]
     residual_friction_angle: float = math.radians(30)  # φ_r [rad]
-    softening_strain: float = 0.05   # κ_s [-]
+    softening_strain: float = 0.01   # κ_s [-]
     base_friction_angle: float = math.radians(36)  # δ [rad] of the flume base (sand glued on it: δ = φ)
     hydraulic_conductivity: float = 1e-3  # k [m s⁻¹]
     water_density: float = 1000.0    # ρw [kg m⁻³]
@@ -53,7 +55,7 @@ class SandPileScene:
     head_end: float = 0.12           # inflow water level at the end of the ramp (the crest) [m]
     settle_time: float = 0.05        # head held at head_start from t = 0 [s]
     head_ramp_time: float = 0.3      # duration of the linear rise that follows [s]
-    hold_time: float = 0.2           # head held at head_end after the rise [s]
+    hold_time: float = 0.25          # head held at head_end after the rise [s]
 
     def toe_x(self):
         """x of the downstream toe [m]."""

@@ -246,6 +246,29 @@ TEST(MohrCoulomb, PlaneReturnDilatesAsTheFlowRuleSays)
 	EXPECT_NEAR(dep(1, 1), 0, 1e-15); // no plastic strain along the intermediate stress on the plane
 }
 
+TEST(MohrCoulomb, DilatancyFadesWithSofteningToTheCriticalState)
+{
+	// eq. 7.1b: ψ(κ) = ψ (φ(κ) − φ_r)/(φ − φ_r); the plane return's dilatancy ratio −sin ψ(κ) is
+	// that of the peak at κ = 0, half-way at φ(κ) half-way, and vanishes at the residual strength.
+	StrengthParameters p;
+	p.frictionAngle         = 36 * degree;
+	p.residualFrictionAngle = 30 * degree;
+	p.softeningStrain       = 0.05;
+	p.dilatancyAngle        = 6 * degree;
+	const Mat3 trial        = -Vec3(30e3, 50e3, 120e3).asDiagonal().toDenseMatrix();
+	auto       ratio        = [&](Real kappa) {
+                const auto r  = returnMohrCoulomb(trial, K, G, p, kappa);
+                const Mat3 ds = trial - r.stress;
+                const Mat3 dep = (ds - (K - 2 * G / 3) / (3 * K) * ds.trace() * Mat3::Identity()) / (2 * G);
+                return -dep.trace() / (-dep(2, 2) + dep(0, 0));
+	};
+	const Real half = p.softeningStrain * std::log(2.0); // φ(κ) − φ_r = (φ − φ_r)/2
+	EXPECT_NEAR(ratio(0), -std::sin(6 * degree), 1e-9);
+	EXPECT_NEAR(ratio(half), -std::sin(3 * degree), 1e-9);
+	EXPECT_NEAR(ratio(40 * p.softeningStrain), 0, 1e-9);
+	EXPECT_NEAR(p.dilatancyAngleAt(half), 3 * degree, 1e-12);
+}
+
 TEST(MohrCoulomb, ElasticInsideAndStressFreeApexForCohesionlessSand)
 {
 	StrengthParameters p;

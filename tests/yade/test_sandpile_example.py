@@ -1,6 +1,7 @@
 """The sand-pile example in quick mode, end to end in YADE (examples/sandpile/sandpile.py): it runs
-the whole head history, writes every output, keeps the water mass balance closed and stands still
-while the head is held low; the pore pressure at the upstream probe follows the rising head."""
+the whole head history, writes every output, keeps the water mass balance closed, stands still
+while the head is held low and fails after it has risen, along a surface through the toe region;
+the pore pressure at the upstream probe follows the rising head."""
 import csv
 import json
 import os
@@ -45,6 +46,27 @@ def test_pile_stands_while_the_head_is_low(quick_run):
     _, summary, _ = quick_run
     # toe displacement at the end of settling: elastic settlement only (γ H²/E ≈ 15 µm)
     assert abs(summary["stable_before_rise"]["toe_displacement_m"]) < 1e-4
+    assert summary["stable_before_rise"]["face_displacement_m"] < 1e-4
+
+
+def test_pile_fails_after_the_head_has_risen(quick_run):
+    _, summary, rows = quick_run
+    scene = summary["scene"]
+    failure = summary["failure"]
+    assert failure is not None, "no failure: lower slope face moved %.2e m" % rows[-1]["face_displacement_m"]
+    # not while the head is low, nor early in the rise: the seepage has to build up first
+    assert failure["time_s"] > scene["settle_time"] + 0.5 * scene["head_ramp_time"]
+    assert failure["head_m"] > 0.5 * (scene["head_start"] + scene["head_end"])
+    # a slide, not a creep: the face keeps moving faster after the criterion than before it
+    after = [r for r in rows if r["time_s"] > failure["time_s"]]
+    assert after and rows[-1]["face_displacement_m"] > 2 * failure["face_displacement_m"]
+
+
+def test_sliding_surface_passes_through_the_toe_region(quick_run):
+    _, summary, _ = quick_run
+    surface = summary["sliding_surface"]
+    assert surface is not None
+    assert surface["passes_through_toe_region"], surface
 
 
 def test_upstream_pore_pressure_follows_the_rising_head(quick_run):
