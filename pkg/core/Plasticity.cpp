@@ -27,11 +27,10 @@ Real StrengthParameters::frictionAngleAt(Real kappa) const
 	return residualFrictionAngle + (frictionAngle - residualFrictionAngle) * std::exp(-kappa / softeningStrain);
 }
 
-Real StrengthParameters::dilatancyAngleAt(Real kappa) const
+Real StrengthParameters::dilatancyAngleFor(Real phi) const
 {
-	const Real phi = frictionAngleAt(kappa);
-	if (softeningStrain <= 0 || !(frictionAngle > residualFrictionAngle)) return std::min(dilatancyAngle, phi);
-	return std::min(dilatancyAngle * (phi - residualFrictionAngle) / (frictionAngle - residualFrictionAngle), phi);
+	const Real excess = frictionAngle > residualFrictionAngle ? (phi - residualFrictionAngle) / (frictionAngle - residualFrictionAngle) : 1;
+	return std::min(dilatancyAngle * excess, phi);
 }
 
 DruckerPragerCone DruckerPragerCone::planeStrainMatch(Real phi, Real psi)
@@ -44,7 +43,7 @@ DruckerPragerCone DruckerPragerCone::planeStrainMatch(Real phi, Real psi)
 ReturnResult returnDruckerPrager(const Mat3& trial, Real K, Real G, const StrengthParameters& strength, Real kappa)
 {
 	const Real              phi  = strength.frictionAngleAt(kappa);
-	const DruckerPragerCone cone = DruckerPragerCone::planeStrainMatch(phi, strength.dilatancyAngleAt(kappa));
+	const DruckerPragerCone cone = DruckerPragerCone::planeStrainMatch(phi, strength.dilatancyAngleFor(phi));
 	const Real              c    = strength.cohesion;
 	const Real              P    = -trial.trace() / 3;              // compression-positive mean stress
 	const Mat3              s    = trial + P * Mat3::Identity();    // deviator
@@ -81,7 +80,7 @@ ReturnResult returnMohrCoulomb(const Mat3& trial, Real K, Real G, const Strength
 	Eigen::SelfAdjointEigenSolver<Mat3> eig(trial);
 	const Vec3r tensionAscending = eig.eigenvalues(); // λ0 ≤ λ1 ≤ λ2 (tension-positive)
 	const Vec3r st(-tensionAscending[0], -tensionAscending[1], -tensionAscending[2]);
-	const Real  phi = strength.frictionAngleAt(kappa), psi = strength.dilatancyAngleAt(kappa);
+	const Real  phi = strength.frictionAngleAt(kappa), psi = strength.dilatancyAngleFor(phi);
 	const Real  sp = std::sin(phi), sq = std::sin(psi), c = strength.cohesion;
 	const Real  apex = std::min(c / std::tan(phi), strength.tensionCutoff); // largest isotropic tension carried (as in eq. 7.3)
 	auto f = [&](const Vec3r& s, int major, int minor) { return (s[major] - s[minor]) - (s[major] + s[minor]) * sp - 2 * c * std::cos(phi); };

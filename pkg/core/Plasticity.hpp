@@ -24,9 +24,10 @@ struct StrengthParameters {
 
 	void validate() const;
 	Real frictionAngleAt(Real plasticShearStrain) const; // φ(κ) [rad]
-	// ψ(κ) [rad]: with softening the dilatancy fades with the friction's excess over the residual
-	// (critical-state) value, ψ(κ) = ψ (φ(κ) − φ_r)/(φ − φ_r) (theory.md eq. 7.1b); never above φ(κ)
-	Real dilatancyAngleAt(Real plasticShearStrain) const;
+	// ψ [rad] at the current friction angle φ(κ): the dilatancy fades with the friction's excess
+	// over the residual (critical-state) value, ψ (φ(κ) − φ_r)/(φ − φ_r) (theory.md eq. 7.1b), so it
+	// is ψ without softening; never above φ(κ)
+	Real dilatancyAngleFor(Real currentFrictionAngle) const;
 };
 
 // Drucker–Prager cone coefficients matched to Mohr–Coulomb in plane strain (theory.md eq. 7.2).

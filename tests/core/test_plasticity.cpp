@@ -266,7 +266,7 @@ TEST(MohrCoulomb, DilatancyFadesWithSofteningToTheCriticalState)
 	EXPECT_NEAR(ratio(0), -std::sin(6 * degree), 1e-9);
 	EXPECT_NEAR(ratio(half), -std::sin(3 * degree), 1e-9);
 	EXPECT_NEAR(ratio(40 * p.softeningStrain), 0, 1e-9);
-	EXPECT_NEAR(p.dilatancyAngleAt(half), 3 * degree, 1e-12);
+	EXPECT_NEAR(p.dilatancyAngleFor(p.frictionAngleAt(half)), 3 * degree, 1e-12);
 }
 
 TEST(MohrCoulomb, ElasticInsideAndStressFreeApexForCohesionlessSand)

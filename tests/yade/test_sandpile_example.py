@@ -57,11 +57,15 @@ def test_pile_fails_after_the_head_has_risen(quick_run):
     # not while the head is low, nor early in the rise: the seepage has to build up first
     assert failure["time_s"] > scene["settle_time"] + 0.5 * scene["head_ramp_time"]
     assert failure["head_m"] > 0.5 * (scene["head_start"] + scene["head_end"])
-    # a slide, not a creep: it goes on after the criterion and the pile moves far faster than it
-    # did while the head rose (measured: face 1.30 → 2.38 mm; max speed 0.005 → 0.44 m/s)
-    rise_end = [r for r in rows if r["time_s"] <= scene["settle_time"] + scene["head_ramp_time"] + 1e-9][-1]
-    assert rows[-1]["face_displacement_m"] > 1.5 * failure["face_displacement_m"]
-    assert rows[-1]["max_solid_speed_m_per_s"] > 10 * rise_end["max_solid_speed_m_per_s"]
+    # a slide, not a creep that arrests: over the last 0.05 s the lower face moves at least as fast
+    # as over the 0.05 s up to the criterion, and far faster than while the head rose (measured
+    # 18.6 against 15.3 and 0.66 mm/s)
+    def face_rate(t_end, span=0.05):
+        near = lambda t: min(rows, key=lambda r: abs(r["time_s"] - t))
+        return (near(t_end)["face_displacement_m"] - near(t_end - span)["face_displacement_m"]) / span
+    rise_end = scene["settle_time"] + scene["head_ramp_time"]
+    assert face_rate(rows[-1]["time_s"]) >= face_rate(failure["time_s"])
+    assert face_rate(rows[-1]["time_s"]) > 10 * face_rate(rise_end)
 
 
 def test_sliding_surface_passes_through_the_toe_region(quick_run):
