@@ -11,6 +11,7 @@ NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& 
 	const int       idx[3] = { i, j, k };
 	bool            onFixedWall = false;
 	for (int axis = 0; axis < 3; ++axis) {
+		if (grid.periodic[axis]) continue; // no wall across a periodic axis
 		for (int side = 0; side < 2; ++side) {
 			const bool onOrBeyond = side == 0 ? idx[axis] <= grid.wallNode[axis] : idx[axis] >= grid.upperWallNode[axis];
 			if (!onOrBeyond) continue;
@@ -50,7 +51,7 @@ void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions&
 		inward[axis]         = upperFace ? -1 : 1;
 		// centroid of N on the face, where a linearly varying p̄ gives ∫ p̄ N dA = p̄(centroid) ∫ N dA:
 		// the node itself inside, h/3 inwards on an edge (the tent is one-sided there)
-		auto centroidShift = [&](int d, int i) { return i == grid.wallNode[d] ? h / 3 : (i == grid.upperWallNode[d] ? -h / 3 : 0.0); };
+		auto centroidShift = [&](int d, int i) { return grid.periodic[d] ? 0.0 : i == grid.wallNode[d] ? h / 3 : (i == grid.upperWallNode[d] ? -h / 3 : 0.0); };
 		for (int j = 0; j < grid.nodes[a1]; ++j)
 			for (int k = 0; k < grid.nodes[a2]; ++k) {
 				const Real area = grid.inDomainSupport(a1, j) * grid.inDomainSupport(a2, k); // ∫ N dA over the face

@@ -58,6 +58,9 @@ struct WallConditions {
 // One entry per Face (XMin, XMax, YMin, YMax, ZMin, ZMax).
 struct BoundaryConditions {
 	std::array<WallConditions, faceCount> walls {};
+	// Per axis: the domain repeats along it (theory.md §2.7), points leaving through one face enter
+	// through the other and the two faces are no walls (their conditions must stay the defaults).
+	std::array<bool, 3> periodic { false, false, false };
 };
 
 // Which velocity components are held at zero at one node, per phase.

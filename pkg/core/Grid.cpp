@@ -8,12 +8,13 @@
 
 namespace mpm {
 
-GridGeometry GridGeometry::forDomain(const Vec3& lower, const Vec3& upper, Real cellSize)
+GridGeometry GridGeometry::forDomain(const Vec3& lower, const Vec3& upper, Real cellSize, const std::array<bool, 3>& periodic)
 {
 	requireOpenRange("cellSize", cellSize, 0, std::numeric_limits<double>::infinity(), "m");
 	GridGeometry g;
 	g.cellSize = cellSize;
 	g.origin   = lower - Vec3::Constant(cellSize);
+	g.periodic = periodic;
 	for (int d = 0; d < 3; ++d) {
 		const Real cells = (upper[d] - lower[d]) / cellSize;
 		const Real whole = std::round(cells);
@@ -26,6 +27,12 @@ GridGeometry GridGeometry::forDomain(const Vec3& lower, const Vec3& upper, Real 
 		g.wallNode[d]      = 1;
 		g.upperWallNode[d] = 1 + static_cast<int>(whole);
 		g.nodes[d]         = static_cast<int>(whole) + 3;
+		// one cell would make a stencil's nodes coincide after wrapping (3 GIMP nodes on one node)
+		if (periodic[d] && whole < 3) {
+			std::ostringstream msg;
+			msg << "periodic axis " << d << " has " << whole << " cells; it needs at least 3 (the GIMP stencil)";
+			throw InvalidParameter(msg.str());
+		}
 	}
 	return g;
 }

@@ -20,16 +20,27 @@ struct GridGeometry {
 	std::array<int, 3> nodes;    // node count per axis
 	std::array<int, 3> wallNode; // index of the node plane of the lower walls (1)
 	std::array<int, 3> upperWallNode;
+	// Periodic axes (theory.md §2.7): node upperWallNode is node wallNode, so the nodes in use along
+	// such an axis are wallNode .. upperWallNode − 1 and a stencil index wraps onto them.
+	std::array<bool, 3> periodic { false, false, false };
 
-	static GridGeometry forDomain(const Vec3& lower, const Vec3& upper, Real cellSize);
+	static GridGeometry forDomain(const Vec3& lower, const Vec3& upper, Real cellSize, const std::array<bool, 3>& periodic = { false, false, false });
 	std::size_t         nodeCount() const { return static_cast<std::size_t>(nodes[0]) * nodes[1] * nodes[2]; }
 	std::size_t         index(int i, int j, int k) const { return static_cast<std::size_t>(i) + nodes[0] * (static_cast<std::size_t>(j) + static_cast<std::size_t>(nodes[1]) * k); }
 	Vec3                nodePosition(int i, int j, int k) const { return origin + cellSize * Vec3(i, j, k); }
 	Vec3                lower() const { return nodePosition(wallNode[0], wallNode[1], wallNode[2]); }
+	// Node index i along axis d after wrapping a periodic axis onto [wallNode, upperWallNode)
+	int wrap(int d, int i) const
+	{
+		if (!periodic[d]) return i;
+		const int cells = upperWallNode[d] - wallNode[d], shifted = (i - wallNode[d]) % cells;
+		return wallNode[d] + (shifted < 0 ? shifted + cells : shifted);
+	}
 	// Length along axis d of node i's support inside the domain box, ∫ N_i dx over the box [m]:
 	// h inside, h/2 on a wall plane, 0 beyond the walls.
 	Real inDomainSupport(int d, int i) const
 	{
+		if (periodic[d]) return i >= wallNode[d] && i < upperWallNode[d] ? cellSize : 0; // no walls: every node in use is interior
 		if (i < wallNode[d] || i > upperWallNode[d]) return 0;
 		return i == wallNode[d] || i == upperWallNode[d] ? cellSize / 2 : cellSize;
 	}
@@ -64,6 +75,19 @@ struct PressureNode {
 	Real pressureVolume; // Σ S V_wp p [Pa m³]
 	Real volume;         // Σ S V_wp [m³]
 };
+
+// Nodal sums of the MUSL re-map (theory.md eq. 4.12).
+struct MomentumNode {
+	Vec3 momentum; // Σ S m_p v_p [kg m s⁻¹]
+	Real mass;     // Σ S m_p [kg]
+};
+
+inline MomentumNode& operator+=(MomentumNode& a, const MomentumNode& b)
+{
+	a.momentum += b.momentum;
+	a.mass += b.mass;
+	return a;
+}
 
 inline PressureNode& operator+=(PressureNode& a, const PressureNode& b)
 {

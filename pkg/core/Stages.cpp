@@ -16,22 +16,36 @@ namespace {
 		for (int d = 0; d < 3; ++d) Kernel::evaluate((x[d] - g.origin[d]) * invH, std::min<Real>(halfLength[d] * invH, 0.5), invH, w[d]);
 	}
 
-	// Call f(node, S, ∇S) for every node of the point's stencil (tensor product).
+	// Call f(node, S, ∇S) for every node of the point's stencil (tensor product); indices along a
+	// periodic axis wrap (theory.md §2.7).
 	template <class Kernel, class F> inline void forEachNode(const GridGeometry& g, const Weights1D (&w)[3], F&& f)
 	{
 		constexpr int S = Kernel::stencil;
+		int           ix[S];
+		for (int a = 0; a < S; ++a) ix[a] = g.wrap(0, w[0].first + a);
 		for (int c = 0; c < S; ++c)
 			for (int b = 0; b < S; ++b) {
 				const Real        vyz  = w[1].value[b] * w[2].value[c];
 				const Real        gyz  = w[1].gradient[b] * w[2].value[c];
 				const Real        vygz = w[1].value[b] * w[2].gradient[c];
-				const std::size_t row  = g.index(w[0].first, w[1].first + b, w[2].first + c);
+				const std::size_t row  = g.index(0, g.wrap(1, w[1].first + b), g.wrap(2, w[2].first + c));
 				for (int a = 0; a < S; ++a) {
 					const Real N = w[0].value[a] * vyz;
 					if (N == 0 && w[0].gradient[a] == 0) continue;
-					f(row + a, N, Vec3(w[0].gradient[a] * vyz, w[0].value[a] * gyz, w[0].value[a] * vygz));
+					f(row + ix[a], N, Vec3(w[0].gradient[a] * vyz, w[0].value[a] * gyz, w[0].value[a] * vygz));
 				}
 			}
+	}
+
+	// A periodic coordinate brought back into [lower, upper) (theory.md §2.7)
+	inline void wrapPosition(const GridGeometry& g, Vec3& x)
+	{
+		for (int d = 0; d < 3; ++d) {
+			if (!g.periodic[d]) continue;
+			const Real lower = g.origin[d] + g.wallNode[d] * g.cellSize, length = (g.upperWallNode[d] - g.wallNode[d]) * g.cellSize;
+			x[d] -= length * std::floor((x[d] - lower) / length);
+			if (x[d] >= lower + length) x[d] -= length; // round-off of the line above
+		}
 	}
 
 	// Race-free scatter: thread 0 adds into `target`, the others into private copies that are
@@ -40,6 +54,7 @@ namespace {
 	inline WaterNode zeroOf(const WaterNode&) { return WaterNode { 0, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0, 0 }; }
 	inline Vec3      zeroOf(const Vec3&) { return Vec3::Zero(); }
 	inline PressureNode zeroOf(const PressureNode&) { return PressureNode { 0, 0 }; }
+	inline MomentumNode zeroOf(const MomentumNode&) { return MomentumNode { Vec3::Zero(), 0 }; }
 
 	template <class Node, class F> void scatter(std::vector<Node>& target, std::vector<std::vector<Node>>& buffers, std::size_t count, F&& perPoint)
 	{
@@ -311,16 +326,16 @@ namespace stages {
 			const Vec3 v        = flipBlend * (points.velocity[p] + dv) + (1 - flipBlend) * vNew; // eq. 4.11
 			points.velocity[p]  = v;
 			points.position[p] += dt * vNew;
+			wrapPosition(grid, points.position[p]);
 			if (!v.allFinite() || !(dt * vNew.norm() <= grid.cellSize))
 				invalid = std::max<long>(invalid, static_cast<long>(count - p)); // smallest index wins
 		}
 		return invalid < 0 ? -1 : static_cast<long>(count) - invalid;
 	}
 
-	template <class Kernel, class Node>
-	void remapVelocities(const GridGeometry& grid, const std::vector<const MaterialPointSet*>& sets, const std::vector<Node>& nodes,
-	                     Real massTolerance, const ConstrainedNodes& constrained, bool solidPhase, std::vector<Vec3>& remapped,
-	                     std::vector<std::vector<Vec3>>& workspace)
+	template <class Kernel>
+	void remapVelocities(const GridGeometry& grid, const std::vector<const MaterialPointSet*>& sets, Real massTolerance,
+	                     const ConstrainedNodes& constrained, bool solidPhase, std::vector<Vec3>& remapped, ScatterWorkspace& workspace)
 	{
 		// Contact (frictional) wall nodes keep the velocity the contact gave them (eq. 2.6): the
 		// points next to a wall carry the interior's velocity, and remapping them would undo a
@@ -328,20 +343,26 @@ namespace stages {
 		std::vector<Vec3> contactVelocity;
 		if (solidPhase)
 			for (std::size_t c : constrained.contact) contactVelocity.push_back(remapped[constrained.node[c]]);
-		std::fill(remapped.begin(), remapped.end(), Vec3::Zero());
-		// momenta only: accumulate Σ S m v into `remapped`, then divide by the (unchanged) nodal mass
+		// Σ S m v and Σ S m with the weights at the moved points: dividing by the nodal mass of the
+		// step's start instead would make a uniformly moving body strain by ~ |v| Δt/h per step
+		std::vector<MomentumNode>& sums = workspace.remap;
+		sums.assign(remapped.size(), zeroOf(MomentumNode {}));
 		for (const MaterialPointSet* set : sets) {
 			const MaterialPointSet& P = *set;
-			scatter(remapped, workspace, P.size(), [&](std::size_t p, Vec3* momenta) {
+			scatter(sums, workspace.momentum, P.size(), [&](std::size_t p, MomentumNode* nodes) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
-				const Vec3 mv = P.mass[p] * P.velocity[p];
-				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) { momenta[I] += N * mv; });
+				const Real m  = P.mass[p];
+				const Vec3 mv = m * P.velocity[p];
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+					nodes[I].momentum += N * mv;
+					nodes[I].mass += N * m;
+				});
 			});
 		}
-		const std::size_t count = nodes.size();
+		const std::size_t count = sums.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t i = 0; i < count; ++i) remapped[i] = nodes[i].mass > massTolerance ? Vec3(remapped[i] / nodes[i].mass) : Vec3::Zero();
+		for (std::size_t i = 0; i < count; ++i) remapped[i] = sums[i].mass > massTolerance ? Vec3(sums[i].momentum / sums[i].mass) : Vec3::Zero();
 		for (std::size_t c = 0; c < constrained.node.size(); ++c)
 			applyConstraint(solidPhase ? constrained.constraint[c].solid : constrained.constraint[c].water, remapped[constrained.node[c]]);
 		for (std::size_t f = 0; f < contactVelocity.size(); ++f) remapped[constrained.node[constrained.contact[f]]] = contactVelocity[f];
@@ -418,8 +439,8 @@ namespace stages {
 					for (int a = 0; a < Kernel::stencil && inside; ++a) {
 						const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
 						if (N <= 0) continue;
-						const int idx[3] = { w[0].first + a, w[1].first + b, w[2].first + c };
-						for (int d = 0; d < 3; ++d) inside = inside && idx[d] > grid.wallNode[d] && idx[d] < grid.upperWallNode[d];
+						const int idx[3] = { grid.wrap(0, w[0].first + a), grid.wrap(1, w[1].first + b), grid.wrap(2, w[2].first + c) };
+						for (int d = 0; d < 3; ++d) inside = inside && (grid.periodic[d] || (idx[d] > grid.wallNode[d] && idx[d] < grid.upperWallNode[d]));
 						const std::size_t I = grid.index(idx[0], idx[1], idx[2]);
 						inside              = inside && fields.water[I].volume >= fullVolume;
 						if (inside) smoothed += N * nodes[I].pressureVolume / nodes[I].volume; // the point's own volume makes nodes[I] non-empty
@@ -509,7 +530,7 @@ namespace stages {
 					for (int a = 0; a < 3; ++a) {
 						const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
 						if (N <= 0) continue;
-						const int  i = w[0].first + a, j = w[1].first + b, k = w[2].first + c;
+						const int  i = grid.wrap(0, w[0].first + a), j = grid.wrap(1, w[1].first + b), k = grid.wrap(2, w[2].first + c);
 						const Real expected = grid.inDomainSupportVolume(i, j, k);
 						filling += N * (expected > 0 ? fields.water[grid.index(i, j, k)].volume / expected : 1.0);
 					}
@@ -546,10 +567,8 @@ namespace stages {
 	template void mapWaterToGrid<K>(const GridGeometry&, std::vector<WaterPointSet*>&, const Vec3&, GridFields&, ScatterWorkspace&);       \
 	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, MaterialPointSet&,    \
 	                                       Real, Real);                                                                                    \
-	template void remapVelocities<K, SolidNode>(const GridGeometry&, const std::vector<const MaterialPointSet*>&,                          \
-	                                            const std::vector<SolidNode>&, Real, const ConstrainedNodes&, bool, std::vector<Vec3>&, std::vector<std::vector<Vec3>>&); \
-	template void remapVelocities<K, WaterNode>(const GridGeometry&, const std::vector<const MaterialPointSet*>&,                          \
-	                                            const std::vector<WaterNode>&, Real, const ConstrainedNodes&, bool, std::vector<Vec3>&, std::vector<std::vector<Vec3>>&); \
+	template void remapVelocities<K>(const GridGeometry&, const std::vector<const MaterialPointSet*>&, Real, const ConstrainedNodes&, bool,  \
+	                                 std::vector<Vec3>&, ScatterWorkspace&);                                                              \
 	template void computeVelocityGradients<K>(const GridGeometry&, const std::vector<Vec3>&, const MaterialPointSet&, std::vector<Mat3>&);  \
 	template void computePressureRates<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const WaterPointSet&,   \
 	                                     const WaterParameters&, std::vector<Real>&, std::vector<Real>&);                                   \

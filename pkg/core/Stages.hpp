@@ -45,7 +45,8 @@ struct SolidSet {
 struct ScatterWorkspace {
 	std::vector<std::vector<SolidNode>> solid;
 	std::vector<std::vector<WaterNode>> water;
-	std::vector<std::vector<Vec3>>      momentum;
+	std::vector<MomentumNode>              remap; // Σ S m v and Σ S m at the moved points (step 8)
+	std::vector<std::vector<MomentumNode>> momentum;
 	std::vector<std::vector<PressureNode>> pressure;
 };
 
@@ -101,11 +102,11 @@ namespace stages {
 	                           MaterialPointSet& points, Real dt, Real flipBlend);
 
 	// Step 8 (theory.md eq. 4.12): MUSL re-map of the point momenta of one phase to the grid,
-	// written to `remapped` (v̂_I), then the wall constraints of that phase.
-	template <class Kernel, class Node>
-	void remapVelocities(const GridGeometry& grid, const std::vector<const MaterialPointSet*>& sets, const std::vector<Node>& nodes,
-	                     Real massTolerance, const ConstrainedNodes& constrained, bool solidPhase, std::vector<Vec3>& remapped,
-	                     std::vector<std::vector<Vec3>>& workspace);
+	// written to `remapped` (v̂_I), then the wall constraints of that phase. Momentum and mass are
+	// both mapped from the moved points, so a uniform point velocity gives that velocity at every node.
+	template <class Kernel>
+	void remapVelocities(const GridGeometry& grid, const std::vector<const MaterialPointSet*>& sets, Real massTolerance,
+	                     const ConstrainedNodes& constrained, bool solidPhase, std::vector<Vec3>& remapped, ScatterWorkspace& workspace);
 
 	// Velocity gradient L_ij = Σ v_i ∂S/∂x_j at every point of a set (theory.md eq. 4.13).
 	template <class Kernel>

@@ -67,9 +67,18 @@ void SolverSettings::validate() const
 TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& settings)
         : domain_(domain)
         , settings_(settings)
-        , grid_(GridGeometry::forDomain(domain.lower, domain.upper, domain.cellSize))
+        , grid_(GridGeometry::forDomain(domain.lower, domain.upper, domain.cellSize, domain.boundaries.periodic))
 {
 	settings_.validate();
+	// the two faces of a periodic axis are no walls: a condition set on them would be silently ignored
+	const WallConditions noWall {};
+	for (int f = 0; f < faceCount; ++f) {
+		const WallConditions& w = domain_.boundaries.walls[f];
+		if (domain_.boundaries.periodic[f / 2] &&
+		    (w.solid != noWall.solid || w.water != noWall.water || w.inflow || w.drainedPressure != 0 || w.friction != 0 || w.waterTable != noWall.waterTable))
+			throw InvalidParameter("face " + std::to_string(f) + " (0..5 = xMin..zMax) lies across the periodic axis " + std::to_string(f / 2) +
+			                       ": its wall conditions must stay free (solid Free, water Free, no inflow, no drained pressure, friction or water table)");
+	}
 	for (int f = 0; f < faceCount; ++f)
 		if (domain_.boundaries.walls[f].inflow && domain_.boundaries.walls[f].water != WaterWall::Drained)
 			throw InvalidParameter("the inflow face " + std::to_string(f) + " (0..5 = xMin..zMax) must be a drained water wall");
@@ -218,8 +227,8 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 		std::vector<const MaterialPointSet*> solidSets, waterSets;
 		for (const SolidSet& s : solids_) solidSets.push_back(s.points);
 		for (const WaterPointSet* w : waters_) waterSets.push_back(w);
-		remapVelocities<Kernel>(grid_, solidSets, fields_.solid, solidMassTolerance_, constrained_, true, fields_.solidVelocityNew, workspace_.momentum);
-		if (wet) remapVelocities<Kernel>(grid_, waterSets, fields_.water, waterMassTolerance_, constrained_, false, fields_.waterVelocityNew, workspace_.momentum);
+		remapVelocities<Kernel>(grid_, solidSets, solidMassTolerance_, constrained_, true, fields_.solidVelocityNew, workspace_);
+		if (wet) remapVelocities<Kernel>(grid_, waterSets, waterMassTolerance_, constrained_, false, fields_.waterVelocityNew, workspace_);
 	}
 	const bool average = settings_.cellAveragedVolumetricRate;
 	{
