@@ -55,7 +55,7 @@ class SandPileScene:
     head_end: float = 0.12           # inflow water level at the end of the ramp (the crest) [m]
     settle_time: float = 0.05        # head held at head_start from t = 0 [s]
     head_ramp_time: float = 0.3      # duration of the linear rise that follows [s]
-    hold_time: float = 0.25          # head held at head_end after the rise [s]
+    hold_time: float = 0.35          # head held at head_end after the rise [s]
 
     def toe_x(self):
         """x of the downstream toe [m]."""
