@@ -16,23 +16,30 @@ namespace {
 		for (int d = 0; d < 3; ++d) Kernel::evaluate((x[d] - g.origin[d]) * invH, std::min<Real>(halfLength[d] * invH, 0.5), invH, w[d]);
 	}
 
-	// Call f(node, S, ∇S) for every node of the point's stencil (tensor product); indices along a
-	// periodic axis wrap (theory.md §2.7).
+	// Node indices of the stencil per axis, wrapped along periodic axes (theory.md §2.7):
+	// node[d][a] is the a-th stencil node along axis d.
+	template <int S> inline void stencilNodes(const GridGeometry& g, const Weights1D (&w)[3], int (&node)[3][S])
+	{
+		for (int d = 0; d < 3; ++d)
+			for (int a = 0; a < S; ++a) node[d][a] = g.wrap(d, w[d].first + a);
+	}
+
+	// Call f(node, S, ∇S) for every node of the point's stencil (tensor product).
 	template <class Kernel, class F> inline void forEachNode(const GridGeometry& g, const Weights1D (&w)[3], F&& f)
 	{
 		constexpr int S = Kernel::stencil;
-		int           ix[S];
-		for (int a = 0; a < S; ++a) ix[a] = g.wrap(0, w[0].first + a);
+		int           node[3][S];
+		stencilNodes(g, w, node);
 		for (int c = 0; c < S; ++c)
 			for (int b = 0; b < S; ++b) {
 				const Real        vyz  = w[1].value[b] * w[2].value[c];
 				const Real        gyz  = w[1].gradient[b] * w[2].value[c];
 				const Real        vygz = w[1].value[b] * w[2].gradient[c];
-				const std::size_t row  = g.index(0, g.wrap(1, w[1].first + b), g.wrap(2, w[2].first + c));
+				const std::size_t row  = g.index(0, node[1][b], node[2][c]);
 				for (int a = 0; a < S; ++a) {
 					const Real N = w[0].value[a] * vyz;
 					if (N == 0 && w[0].gradient[a] == 0) continue;
-					f(row + ix[a], N, Vec3(w[0].gradient[a] * vyz, w[0].value[a] * gyz, w[0].value[a] * vygz));
+					f(row + node[0][a], N, Vec3(w[0].gradient[a] * vyz, w[0].value[a] * gyz, w[0].value[a] * vygz));
 				}
 			}
 	}
@@ -340,7 +347,8 @@ namespace stages {
 		// Contact (frictional) wall nodes keep the velocity the contact gave them (eq. 2.6): the
 		// points next to a wall carry the interior's velocity, and remapping them would undo a
 		// stick, so the strain rate at the wall would never see the friction.
-		std::vector<Vec3> contactVelocity;
+		std::vector<Vec3>& contactVelocity = workspace.contactVelocity;
+		contactVelocity.clear();
 		if (solidPhase)
 			for (std::size_t c : constrained.contact) contactVelocity.push_back(remapped[constrained.node[c]]);
 		// Σ S m v and Σ S m with the weights at the moved points: dividing by the nodal mass of the
@@ -432,6 +440,8 @@ namespace stages {
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			int node[3][Kernel::stencil];
+			stencilNodes(grid, w, node);
 			bool inside = true;
 			Real smoothed = 0;
 			for (int c = 0; c < Kernel::stencil && inside; ++c)
@@ -439,7 +449,7 @@ namespace stages {
 					for (int a = 0; a < Kernel::stencil && inside; ++a) {
 						const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
 						if (N <= 0) continue;
-						const int idx[3] = { grid.wrap(0, w[0].first + a), grid.wrap(1, w[1].first + b), grid.wrap(2, w[2].first + c) };
+						const int idx[3] = { node[0][a], node[1][b], node[2][c] };
 						for (int d = 0; d < 3; ++d) inside = inside && (grid.periodic[d] || (idx[d] > grid.wallNode[d] && idx[d] < grid.upperWallNode[d]));
 						const std::size_t I = grid.index(idx[0], idx[1], idx[2]);
 						inside              = inside && fields.water[I].volume >= fullVolume;
@@ -523,14 +533,16 @@ namespace stages {
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<GimpKernel>(grid, P.position[p], P.halfLength[p], w);
+			int node[3][GimpKernel::stencil];
+			stencilNodes(grid, w, node);
 			// the point's filling: Σ S_I (water volume of I / full support volume of I)
 			Real filling = 0;
-			for (int c = 0; c < 3; ++c)
-				for (int b = 0; b < 3; ++b)
-					for (int a = 0; a < 3; ++a) {
+			for (int c = 0; c < GimpKernel::stencil; ++c)
+				for (int b = 0; b < GimpKernel::stencil; ++b)
+					for (int a = 0; a < GimpKernel::stencil; ++a) {
 						const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
 						if (N <= 0) continue;
-						const int  i = grid.wrap(0, w[0].first + a), j = grid.wrap(1, w[1].first + b), k = grid.wrap(2, w[2].first + c);
+						const int  i = node[0][a], j = node[1][b], k = node[2][c];
 						const Real expected = grid.inDomainSupportVolume(i, j, k);
 						filling += N * (expected > 0 ? fields.water[grid.index(i, j, k)].volume / expected : 1.0);
 					}

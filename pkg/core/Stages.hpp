@@ -48,6 +48,7 @@ struct ScatterWorkspace {
 	std::vector<MomentumNode>              remap; // Σ S m v and Σ S m at the moved points (step 8)
 	std::vector<std::vector<MomentumNode>> momentum;
 	std::vector<std::vector<PressureNode>> pressure;
+	std::vector<Vec3>                      contactVelocity; // the contact nodes' velocity kept through the re-map
 };
 
 // Grid nodes whose velocity has at least one constrained component, and the constraint.

@@ -24,25 +24,25 @@ namespace {
 
 using namespace mpm;
 
-constexpr double gravity   = 9.81;                // |g| of this test's scene [m s⁻²]
-constexpr double phi       = 30 * M_PI / 180;     // φ = ψ [rad]
-constexpr double cellSize  = 0.02;                // h [m]
+constexpr double gravity    = 9.81; // |g| of this test's scene [m s⁻²]
+constexpr double phi        = 30 * M_PI / 180; // φ = ψ [rad]
+constexpr double cellSize   = 0.02; // h [m]
 constexpr int    layerCells = 4, lengthCells = 6; // H = 4 h thick, 6 h along the slope (periodic)
-constexpr double duration  = 0.3;                 // [s]
-constexpr double slidLimit = 5e-3;                // a slide is called once the surface has moved this far [m]
+constexpr double duration  = 0.3; // [s]
+constexpr double slidLimit = 5e-3; // a slide is called once the surface has moved this far [m]
 
 struct Outcome {
 	double surfaceDisplacement; // mean downslope displacement of the top layer of solid points [m]
-	double time;                // when the run stopped: `duration`, or earlier once it slid [s]
+	double time; // when the run stopped: `duration`, or earlier once it slid [s]
 };
 
 // Runs the layer at slope angle β; `wet`: saturated, water table at the surface, slope-parallel seepage.
 Outcome runLayer(double slopeAngle, bool wet)
 {
-	const double h = cellSize, H = layerCells * h, length = lengthCells * h;
+	const double   h = cellSize, H = layerCells * h, length = lengthCells * h;
 	SoilParameters soil;
-	soil.youngModulus          = 10e6;
-	soil.poissonRatio          = 0.3;
+	soil.youngModulus = 10e6;
+	soil.poissonRatio = 0.3;
 	// k ≈ 1 m/s (κ = 1e-7 m²): drained. A sliding band dilates at sin ψ of its slip rate Δv and
 	// draws that water through the layer with a suction ≈ γw H sin ψ Δv/k, which holds the band
 	// (dilatant hardening) unless it is small against σ′: 16 Pa here at the rigid block's mean speed
@@ -54,9 +54,9 @@ Outcome runLayer(double slopeAngle, bool wet)
 	StrengthParameters strength;
 	strength.frictionAngle = strength.residualFrictionAngle = strength.dilatancyAngle = phi;
 
-	const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(length, h, H), h, 2);
-	SolidPointSet layer = fixtures::solidLattice(l, soil.porosity, soil.density);
-	WaterPointSet pores = wet ? fixtures::waterLattice(l, soil.porosity, water.density) : WaterPointSet {};
+	const auto    l      = fixtures::lattice(Vec3::Zero(), Vec3(length, h, H), h, 2);
+	SolidPointSet layer  = fixtures::solidLattice(l, soil.porosity, soil.density);
+	WaterPointSet pores  = wet ? fixtures::waterLattice(l, soil.porosity, water.density) : WaterPointSet {};
 	const double  rhoDry = (1 - soil.porosity) * soil.density, rhoW = water.density;
 	const double  rhoTotal = wet ? rhoDry + soil.porosity * rhoW : rhoDry, rhoEffective = wet ? rhoTotal - rhoW : rhoDry;
 	const double  t = rhoTotal / rhoEffective * std::tan(slopeAngle); // τ/|σ′_zz| on slope-parallel planes
@@ -73,38 +73,41 @@ Outcome runLayer(double slopeAngle, bool wet)
 	}
 
 	Domain d;
-	d.upper                       = Vec3(length, h, H + 2 * h); // two empty cells above the layer for its dilation
-	d.cellSize                    = h;
-	d.boundaries.periodic         = { true, false, false };
+	d.upper                                          = Vec3(length, h, H + 2 * h); // two empty cells above the layer for its dilation
+	d.cellSize                                       = h;
+	d.boundaries.periodic                            = { true, false, false };
 	d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
 	d.boundaries.walls[static_cast<int>(Face::YMin)] = { SolidWall::Slip, WaterWall::Impermeable };
 	d.boundaries.walls[static_cast<int>(Face::YMax)] = { SolidWall::Slip, WaterWall::Impermeable };
 	SolverSettings s;
 	s.gravity              = Vec3(gravity * std::sin(slopeAngle), 0, -gravity * std::cos(slopeAngle));
 	s.freeSurfaceThreshold = 0.5; // the layer's surface is the water table: p = 0 there (eq. 2.3)
-	TwoPhaseSolver solver(d, s);
+	TwoPhaseSolver              solver(d, s);
 	std::vector<WaterPointSet*> waters;
-	if (wet) waters.push_back(&pores);
+	if (wet)
+		waters.push_back(&pores);
 	solver.setPoints({ SolidSet(&layer, soil, false, SkeletonModel::MohrCoulomb, strength) }, waters, water);
 
-	const auto x0 = layer.position;
+	const auto x0                  = layer.position;
 	auto       surfaceDisplacement = [&] {
-		double sum = 0;
-		int    count = 0;
-		for (std::size_t p = 0; p < layer.size(); ++p) {
-			if (x0[p].z() < H - h / 2) continue;
-			double dx = layer.position[p].x() - x0[p].x();
-			dx -= length * std::round(dx / length); // across the periodic seam (moves are ≪ the length here)
-			sum += dx;
-			++count;
-		}
-		return sum / count;
+                double sum   = 0;
+                int    count = 0;
+                for (std::size_t p = 0; p < layer.size(); ++p) {
+                        if (x0[p].z() < H - h / 2)
+                                continue;
+                        double dx = layer.position[p].x() - x0[p].x();
+                        dx -= length * std::round(dx / length); // across the periodic seam (moves are ≪ the length here)
+                        sum += dx;
+                        ++count;
+                }
+                return sum / count;
 	};
 	const double dt    = 0.5 * solver.timeStepLimits().critical;
 	const long   steps = static_cast<long>(std::ceil(duration / dt));
 	for (long i = 1; i <= steps; ++i) {
 		solver.step(duration / steps);
-		if (i % 100 == 0 && surfaceDisplacement() > slidLimit) return { surfaceDisplacement(), i * duration / steps };
+		if (i % 100 == 0 && surfaceDisplacement() > slidLimit)
+			return { surfaceDisplacement(), i * duration / steps };
 	}
 	return { surfaceDisplacement(), duration };
 }
@@ -118,24 +121,26 @@ double rigidSlide(double slopeAngle, double strengthRatio, double time)
 
 void expectStandsBelowAndSlidesAbove(bool wet)
 {
-	SoilParameters soil;
-	const double   rhoDry = (1 - soil.porosity) * soil.density, rhoSat = rhoDry + soil.porosity * 1000.0;
-	const double   ratio  = wet ? (rhoSat - 1000.0) / rhoSat : 1.0; // γ′/γsat, or 1 dry
-	const double   critical = ratio * std::tan(phi);                  // tan β at collapse
-	const double   below = std::atan(0.9 * critical), above = std::atan(1.1 * critical);
-	const Outcome  standing = runLayer(below, wet), sliding = runLayer(above, wet);
-	std::printf("%s: tan β = 0.9 × %.3f: surface moved %.2e m in %.2f s; 1.1 × %.3f: %.2e m in %.3f s (rigid block: %.2e m)\n",
-	            wet ? "seepage" : "dry", critical, standing.surfaceDisplacement, standing.time, critical, sliding.surfaceDisplacement,
-	            sliding.time, rigidSlide(above, ratio, sliding.time));
-	// Standing: the elastic shear of the layer under its weight is γ sin β H²/(2G) ≈ 10 µm; 0.1 mm
-	// allows ten times that and is 50× below the slide.
+	const SoilParameters  soil;
+	const WaterParameters water;
+	const double          rhoDry = (1 - soil.porosity) * soil.density, rhoSat = rhoDry + soil.porosity * water.density;
+	const double          ratio    = wet ? (rhoSat - water.density) / rhoSat : 1.0; // γ′/γsat, or 1 dry
+	const double          critical = ratio * std::tan(phi); // tan β at collapse
+	const double          below = std::atan(0.9 * critical), above = std::atan(1.1 * critical);
+	const Outcome         standing = runLayer(below, wet), sliding = runLayer(above, wet);
+	std::printf("%s: tan β = 0.9 × %.3f: surface moved %.2e m in %.2f s; 1.1 × %.3f: %.2e m in %.3f s (rigid block: %.2e m)\n", wet ? "seepage" : "dry",
+	    critical, standing.surfaceDisplacement, standing.time, critical, sliding.surfaceDisplacement, sliding.time, rigidSlide(above, ratio, sliding.time));
+	// Standing: the layer starts in equilibrium, so only round-off could move it (measured 0 dry,
+	// 9e-18 m wet); 0.1 mm is 50× below the slide.
 	EXPECT_LT(std::abs(standing.surfaceDisplacement), 1e-4);
 	EXPECT_DOUBLE_EQ(standing.time, duration);
-	// Sliding: the layer has moved 5 mm before the end, and no earlier than a rigid block sliding on
-	// its base at the limit strength would (a shear band is not stronger than the base plane)
+	// Sliding: the layer has moved 5 mm before the end, but not further than a rigid block on a base
+	// of strength tan φ: with ψ = φ a slope-parallel band mobilizes exactly tan φ, so no part of the
+	// layer can outrun that block; 5% for the elastic shear of the layer (µm). Measured 0.75 (dry)
+	// and 0.60 (wet) of the block: the band needs some slip to form.
 	EXPECT_GT(sliding.surfaceDisplacement, slidLimit);
 	EXPECT_LT(sliding.time, duration);
-	EXPECT_GE(rigidSlide(above, ratio, sliding.time), 0.5 * sliding.surfaceDisplacement);
+	EXPECT_LE(sliding.surfaceDisplacement, 1.05 * rigidSlide(above, ratio, sliding.time));
 }
 
 TEST(InfiniteSlope, DryLayerStandsBelowAndSlidesAboveTheFrictionAngle) { expectStandsBelowAndSlidesAbove(false); }

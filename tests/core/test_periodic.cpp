@@ -24,7 +24,8 @@ std::vector<Real> xForceByPlane(bool periodic)
 	GridFields         fields;
 	fields.resize(grid.nodeCount());
 	SolidPointSet s = fixtures::solidLattice(fixtures::lattice(Vec3::Zero(), Vec3(0.4, 0.2, 0.2), 0.1, 2), 0.4, 2650);
-	for (auto& st : s.effectiveStress) st << -5e4, 0, 0, 0, 0, 0;
+	for (auto& st : s.effectiveStress)
+		st << -5e4, 0, 0, 0, 0, 0;
 	SoilParameters        soil;
 	std::vector<SolidSet> solids { SolidSet { &s, soil } };
 	ScatterWorkspace      ws;
@@ -33,11 +34,14 @@ std::vector<Real> xForceByPlane(bool periodic)
 	std::vector<Real> planes(grid.nodes[0], 0);
 	for (int k = 0; k < grid.nodes[2]; ++k)
 		for (int j = 0; j < grid.nodes[1]; ++j)
-			for (int i = 0; i < grid.nodes[0]; ++i) planes[i] += fields.solid[grid.index(i, j, k)].mixtureForce.x();
+			for (int i = 0; i < grid.nodes[0]; ++i)
+				planes[i] += fields.solid[grid.index(i, j, k)].mixtureForce.x();
 	Real mass = 0;
-	for (const auto& n : fields.solid) mass += n.mass;
+	for (const auto& n : fields.solid)
+		mass += n.mass;
 	Real pointMass = 0;
-	for (Real m : s.mass) pointMass += m;
+	for (Real m : s.mass)
+		pointMass += m;
 	EXPECT_NEAR(mass, pointMass, 1e-12 * pointMass); // the wrapped stencil loses no mass
 	return planes;
 }
@@ -50,7 +54,8 @@ TEST(Periodic, UniformStressAcrossTheSeamGivesNoEndForce)
 	const auto bounded  = xForceByPlane(false);
 	EXPECT_NEAR(bounded[1], -endForce, 1e-9 * endForce); // the lower wall plane (node 1) is pushed outwards
 	const auto periodic = xForceByPlane(true);
-	for (std::size_t i = 0; i < periodic.size(); ++i) EXPECT_LT(std::abs(periodic[i]), 1e-9 * endForce) << "node plane " << i;
+	for (std::size_t i = 0; i < periodic.size(); ++i)
+		EXPECT_LT(std::abs(periodic[i]), 1e-9 * endForce) << "node plane " << i;
 }
 
 TEST(Periodic, BlockCrossesTheSeamUnchanged)
@@ -61,7 +66,8 @@ TEST(Periodic, BlockCrossesTheSeamUnchanged)
 	// stress in its first step, bounded or not.)
 	const Real    h = 0.1, length = 5 * h, speed = 1.0;
 	SolidPointSet block = fixtures::solidLattice(fixtures::lattice(Vec3(2 * h, 0, 0), Vec3(4 * h, h, h), h, 2), 0.4, 2650);
-	for (auto& v : block.velocity) v = Vec3(speed, 0, 0);
+	for (auto& v : block.velocity)
+		v = Vec3(speed, 0, 0);
 	Domain d;
 	d.upper               = Vec3(length, h, h);
 	d.cellSize            = h;
@@ -71,7 +77,8 @@ TEST(Periodic, BlockCrossesTheSeamUnchanged)
 	const auto x0 = block.position;
 	const Real dt = 0.5 * solver.timeStepLimits().critical, duration = 2.5 * h / speed; // its front half crosses the seam
 	const long steps = static_cast<long>(std::ceil(duration / dt));
-	for (long i = 0; i < steps; ++i) solver.step(duration / steps);
+	for (long i = 0; i < steps; ++i)
+		solver.step(duration / steps);
 	int wrapped = 0;
 	for (std::size_t p = 0; p < block.size(); ++p) {
 		const Vec3& x = block.position[p];
@@ -79,7 +86,8 @@ TEST(Periodic, BlockCrossesTheSeamUnchanged)
 		EXPECT_LT(x.x(), length);
 		Real dx = x.x() - x0[p].x();
 		wrapped += dx < 0;
-		if (dx < 0) dx += length;
+		if (dx < 0)
+			dx += length;
 		EXPECT_NEAR(dx, speed * duration, 1e-9) << "point " << p;
 		EXPECT_NEAR((x - x0[p]).tail<2>().norm(), 0, 1e-12);
 		EXPECT_NEAR((block.velocity[p] - Vec3(speed, 0, 0)).norm(), 0, 1e-9);
@@ -92,9 +100,9 @@ TEST(Periodic, BlockCrossesTheSeamUnchanged)
 TEST(Periodic, FacesAcrossAPeriodicAxisCannotBeWalls)
 {
 	Domain d;
-	d.upper               = Vec3(0.4, 0.2, 0.2);
-	d.cellSize            = 0.1;
-	d.boundaries.periodic = { false, false, true };
+	d.upper                                          = Vec3(0.4, 0.2, 0.2);
+	d.cellSize                                       = 0.1;
+	d.boundaries.periodic                            = { false, false, true };
 	d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
 	try {
 		TwoPhaseSolver solver(d, SolverSettings {});
