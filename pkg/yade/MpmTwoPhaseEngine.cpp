@@ -70,6 +70,24 @@ mpm::Domain MpmTwoPhaseEngine::domain() const
 			mpm::throwOutOfRange("drainedWaterTable[" + std::string(faceNames[f]) + "]", wall.waterTable, "m", "[-inf (none), inf)");
 		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + std::string(faceNames[f]) + "]", wall.drainedPressure, "Pa", "finite values");
 	}
+	for (int axis = 0; axis < 3; ++axis) {
+		d.boundaries.periodic[axis] = periodic[axis] != 0;
+		if (!d.boundaries.periodic[axis]) continue;
+		const mpm::WallConditions noWall {};
+		for (int f = 2 * axis; f <= 2 * axis + 1; ++f) {
+			const auto& wall   = d.boundaries.walls[f];
+			const auto  refuse = [&](const std::string& attribute, const std::string& value) {
+				throw mpm::InvalidParameter("periodic[" + std::string(1, "xyz"[axis]) + "] is set but " + attribute + "[" + faceNames[f] + "] = " + value +
+				                            ": the faces of a periodic axis are no walls and keep the defaults ('free', no inflow, 0 pressure and friction, no water table)");
+			};
+			if (wall.solid != noWall.solid) refuse("solidWalls", "'" + solidWalls[f] + "'");
+			if (wall.water != noWall.water) refuse("waterWalls", "'" + waterWalls[f] + "'");
+			if (wall.inflow) refuse("waterInflow", "True");
+			if (wall.drainedPressure != noWall.drainedPressure) refuse("drainedPressure", std::to_string(wall.drainedPressure));
+			if (wall.friction != noWall.friction) refuse("wallFriction", std::to_string(wall.friction));
+			if (wall.waterTable != noWall.waterTable) refuse("drainedWaterTable", std::to_string(wall.waterTable));
+		}
+	}
 	d.removeWaterLeavingGrid = removeWaterLeavingGrid;
 	d.removeFreeWater        = removeFreeWater;
 	if (waterSinks.size() % 2) throw mpm::InvalidParameter("waterSinks must hold (lower, upper) corner pairs; it has " + std::to_string(waterSinks.size()) + " corners");
@@ -151,7 +169,7 @@ void MpmTwoPhaseEngine::action()
 MpmTwoPhaseEngine::Structure MpmTwoPhaseEngine::structure() const
 {
 	return Structure { gravity,       timeStepFactor, flipBlend,  domainMin,  domainMax,  cellSize,               shapeFunction, drag,
-		           cellAveraging, pressureModeDamping, freeSurfaceThreshold, freeSurfaceHoldsSuction, solidWalls, wallFriction, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow };
+		           cellAveraging, pressureModeDamping, freeSurfaceThreshold, freeSurfaceHoldsSuction, solidWalls, wallFriction, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow, periodic };
 }
 
 void MpmTwoPhaseEngine::callPostLoad()
@@ -218,22 +236,10 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		boolAttr("removeWaterLeavingGrid", &E::removeWaterLeavingGrid, "Remove water points that leave the grid and count their mass in removedWaterMass (else the run stops) [-]"),
 		fixedListAttr("drainedWaterTable", &E::drainedWaterTable, 6,
 		              "Per 'drained' face, the elevation of a free water surface [m] adding the hydrostatic part ρw |g| max(0, table − z) to p̄ (z measured against gravity); -inf: none"),
-		AttrSpec<E> { "waterInflow", "Per face (xMin..zMax), whether water drawn in through that 'drained' face is supplied as new water points (theory.md eq. 2.5) [-]",
-		              [](const E& e) {
-			              py::list l;
-			              for (int on : e.waterInflow) l.append(on != 0);
-			              return py::object(py::tuple(l));
-		              },
-		              [](E& e, const py::object& v) {
-			              if (py::len(v) != 6) raisePython(PyExc_ValueError, "attribute 'waterInflow' expects 6 entries (xMin, xMax, yMin, yMax, zMin, zMax)");
-			              std::vector<int> on;
-			              for (long i = 0; i < 6; ++i) {
-				              py::extract<bool> b(v[i]);
-				              if (!b.check()) raisePython(PyExc_TypeError, "attribute 'waterInflow' has a non-boolean entry at index " + std::to_string(i));
-				              on.push_back(b() ? 1 : 0);
-			              }
-			              e.waterInflow = on;
-		              } },
+		boolListAttr("waterInflow", &E::waterInflow, 6, "xMin, xMax, yMin, yMax, zMin, zMax",
+		             "Per face (xMin..zMax), whether water drawn in through that 'drained' face is supplied as new water points (theory.md eq. 2.5) [-]"),
+		boolListAttr("periodic", &E::periodic, 3, "x, y, z",
+		             "Per axis (x, y, z), whether the domain repeats along it (theory.md eq. 2.7): points leaving through one face enter through the other, the two faces are no walls (their solidWalls/waterWalls must stay 'free', with no inflow, drained pressure, friction or water table) and the axis needs at least 3 cells [-]"),
 		readOnly(intAttr("stepsDone", &E::stepsDone, "Number of times the engine ran [-]")),
 		readOnly(realAttr("mpmTime", &E::mpmTime, "Total time the MPM state was advanced [s]")),
 		readOnly(intAttr("lastIter", &E::lastIter, "O.iter seen by the last run of the engine [-]")),
@@ -280,6 +286,7 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& BOOST_SERIALIZATION_NVP(removeWaterLeavingGrid);
 	ar& BOOST_SERIALIZATION_NVP(removeFreeWater);
 	ar& BOOST_SERIALIZATION_NVP(waterInflow);
+	ar& BOOST_SERIALIZATION_NVP(periodic);
 	ar& BOOST_SERIALIZATION_NVP(removedWaterMass);
 	ar& BOOST_SERIALIZATION_NVP(injectedWaterMass);
 	if (Archive::is_loading::value) {

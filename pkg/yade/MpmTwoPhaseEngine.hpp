@@ -38,6 +38,7 @@ public:
 	bool                        removeFreeWater        = false; // water points with no solid in their stencil are removed
 	std::vector<yade::Real>  drainedWaterTable = std::vector<yade::Real>(6, -std::numeric_limits<yade::Real>::infinity()); // [m], -inf: none
 	std::vector<int>         waterInflow = std::vector<int>(6, 0); // per face: water points enter through this drained face
+	std::vector<int>         periodic    = std::vector<int>(3, 0); // per axis x, y, z: the domain repeats along it (faces stay free)
 
 	// outputs (read-only from Python)
 	long       stepsDone       = 0; // number of times action() ran [-]
@@ -69,7 +70,7 @@ private:
 	// Everything the solver is built from except the values held on drained faces, which a
 	// running solver takes over in place (a rising head set every step must not rebuild it).
 	using Structure = std::tuple<yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, bool, yade::Real, bool,
-	                             std::vector<std::string>, std::vector<yade::Real>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>>;
+	                             std::vector<std::string>, std::vector<yade::Real>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>, std::vector<int>>;
 	Structure structure() const;
 
 	std::unique_ptr<mpm::TwoPhaseSolver> solver_;  // not serialized: rebuilt on first action()

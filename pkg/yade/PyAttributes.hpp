@@ -107,6 +107,28 @@ template <class T, class E> AttrSpec<T> fixedListAttr(const char* name, std::vec
 			 s.*member = out;
 		 } };
 }
+// A fixed-length list of booleans stored as ints (std::vector<bool> has no element references);
+// `entries` names them in the error message, e.g. "x, y, z".
+template <class T> AttrSpec<T> boolListAttr(const char* name, std::vector<int> T::*member, std::size_t length, const char* entries, const char* doc)
+{
+	return { name, doc,
+		 [member](const T& s) {
+			 py::list l;
+			 for (int on : s.*member) l.append(on != 0);
+			 return py::object(py::tuple(l));
+		 },
+		 [member, name, length, entries](T& s, const py::object& v) {
+			 if (py::len(v) != static_cast<long>(length))
+				 raisePython(PyExc_ValueError, std::string("attribute '") + name + "' expects " + std::to_string(length) + " entries (" + entries + ")");
+			 std::vector<int> out;
+			 for (std::size_t i = 0; i < length; ++i) {
+				 py::extract<bool> b(v[i]);
+				 if (!b.check()) raisePython(PyExc_TypeError, std::string("attribute '") + name + "' has a non-boolean entry at index " + std::to_string(i));
+				 out.push_back(b() ? 1 : 0);
+			 }
+			 s.*member = out;
+		 } };
+}
 template <class T> AttrSpec<T> readOnly(AttrSpec<T> spec)
 {
 	spec.set = nullptr;

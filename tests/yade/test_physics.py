@@ -213,3 +213,45 @@ def test_free_water_is_removed_when_asked_and_water_in_soil_is_not():
     O.dt = 1e-3
     O.run(20, True)
     assert fluid.count == count and engine.removedWaterMass == 0
+
+
+def test_periodic_axis_carries_a_saturated_block_across_the_seam_unstrained():
+    """periodic (eq. 2.7): a saturated block moving at 1 m/s along a periodic x axis leaves through
+    xMax and re-enters through xMin; a rigid translation strains nothing, so the stress, the pore
+    pressure and the velocity stay as they were and every point sits at its start + v t, wrapped."""
+    soil = w.MpmSoilMat(density=2650, youngModulus=20e6, poissonRatio=0.3, porosity=0.4, intrinsicPermeability=1e-10)
+    water = w.MpmWaterMat(density=1000, bulkModulus=2.2e7, viscosity=1e-3)
+    O.materials.append([soil, water])
+    solid_body, water_body = yade_mpm.saturated_block((0.1, 0, 0), (0.3, 0.1, 0.1), 0.05, soil, water, geostatic=False)
+    solid, fluid = solid_body.shape, water_body.shape
+    for points in (solid, fluid):
+        points.vel = np.tile([1.0, 0.0, 0.0], (points.count, 1))
+    O.bodies.append([solid_body, water_body])
+    engine = w.MpmTwoPhaseEngine(label="mpm", domainMin=(0, 0, 0), domainMax=(0.4, 0.1, 0.1), cellSize=0.05, periodic=(True, False, False))
+    assert engine.periodic == (True, False, False)
+    O.engines = [engine]
+    start, masses = solid.pos.copy(), (solid.mass.sum(), fluid.mass.sum())
+    O.dt = 1e-3
+    O.run(250, True)  # 0.25 m: the block (0.1..0.3) now spans 0.35..0.4 and 0..0.15
+    travelled = start + [engine.mpmTime, 0, 0]
+    expected = travelled.copy()
+    expected[:, 0] = np.mod(travelled[:, 0], 0.4)
+    assert (solid.pos[:, 0] >= 0).all() and (solid.pos[:, 0] < 0.4).all()
+    assert (solid.pos[:, 0] < 0.15).sum() == 3 * solid.count // 4  # three quarters crossed the seam
+    assert np.abs(solid.pos - expected).max() < 1e-9
+    assert np.abs(solid.vel - [1, 0, 0]).max() < 1e-9 and np.abs(fluid.vel - [1, 0, 0]).max() < 1e-9
+    assert np.abs(solid.stress).max() < 1e-3 and np.abs(fluid.porePressure).max() < 1e-3  # Pa
+    assert (solid.mass.sum(), fluid.mass.sum()) == masses
+
+
+def test_periodic_axis_refuses_walls_on_its_faces():
+    engine = w.MpmTwoPhaseEngine(domainMin=(0, 0, 0), domainMax=(0.4, 0.1, 0.1), cellSize=0.05, solidWalls=("free",) * 2 + ("slip",) * 4)
+    with pytest.raises(ValueError, match=r"periodic\[y\] is set but solidWalls\[yMin\] = 'slip'"):
+        engine.periodic = (False, True, False)
+    engine.periodic = (True, False, False)
+    with pytest.raises(ValueError, match=r"periodic\[x\] is set but waterWalls\[xMin\] = 'drained'"):
+        engine.waterWalls = ("drained",) + ("free",) * 5
+    with pytest.raises(ValueError, match=r"'periodic' expects 3 entries \(x, y, z\)"):
+        engine.periodic = (True, False)
+    with pytest.raises(TypeError, match=r"'periodic' has a non-boolean entry at index 2"):
+        engine.periodic = (True, False, "yes")
