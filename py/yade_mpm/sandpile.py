@@ -17,7 +17,7 @@ the values below are documented lab-scale choices, not the paper's:
 * the pile starts saturated throughout, at rest: hydrostatic below the inflow level 0.03 m and held
   by capillary suction above it (the experiment keeps the pile saturated for the same reason);
 * head at the inflow face held at 0.03 m for 0.05 s (the pile settles under gravity), then raised
-  linearly to the crest, 0.12 m, over 0.3 s, then held for 0.25 s. The laboratory raises it over
+  linearly to the crest, 0.12 m, over 0.3 s, then held for 0.35 s. The laboratory raises it over
   minutes; the ramp here is compressed because the pore pressures follow it quasi-statically
   either way: they settle in the consolidation time L² γw / (k M) ≈ 0.035 s over the 0.3 m flow
   path (M = 1/(1/E_oed + n/Kw) ≈ 26 MPa), a ninth of the ramp. What the compression does change
