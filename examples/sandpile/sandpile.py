@@ -176,7 +176,7 @@ while O.time < DURATION - 1e-12:
     row = {"time_s": O.time, "head_m": SCENE.head(O.time), "toe_displacement_m": toe_displacement(), "face_displacement_m": face_displacement(),
            "max_solid_speed_m_per_s": float(speed.max()), "water_points": fluid.count, "injected_kg": engine.injectedWaterMass,
            "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual}
-    row.update({"p_%s_Pa" % name.split()[0] + "_" + name.split()[1]: probe_pressure(loc) for name, loc in PROBES.items()})
+    row.update({"p_%s_Pa" % name.replace(" ", "_"): probe_pressure(loc) for name, loc in PROBES.items()})  # e.g. p_upstream_x=0.05_Pa
     rows.append(row)
     if settled is None and O.time >= SCENE.settle_time - 1e-9:
         settled = dict(row)
