@@ -32,6 +32,7 @@ def test_writes_every_output(quick_run):
     out, summary, rows = quick_run
     for name in OUTPUTS:
         assert (out / name).stat().st_size > 0, name
+    assert summary["stopped_unstable"] is None  # ran the whole head history
     assert summary["simulated_time_s"] == pytest.approx(summary["scene"]["settle_time"] + summary["scene"]["head_ramp_time"]
                                                         + summary["scene"]["hold_time"], abs=1e-6)
 
