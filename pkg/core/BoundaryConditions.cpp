@@ -1,9 +1,31 @@
 #include "BoundaryConditions.hpp"
 
-#include "PointSets.hpp"
+#include "Errors.hpp"
 #include "Grid.hpp"
+#include "PointSets.hpp"
+
+#include <string>
 
 namespace mpm {
+
+void BoundaryConditions::requireFreePeriodicFaces() const
+{
+	const WallConditions noWall {};
+	for (int f = 0; f < faceCount; ++f) {
+		if (!periodic[f / 2]) continue;
+		const WallConditions& w = walls[f];
+		const char* condition = w.solid != noWall.solid ? "a solid wall"
+		                      : w.water != noWall.water ? "a water wall"
+		                      : w.inflow ? "inflow"
+		                      : w.drainedPressure != noWall.drainedPressure ? "a drained pressure"
+		                      : w.friction != noWall.friction ? "wall friction"
+		                      : w.waterTable != noWall.waterTable ? "a water table"
+		                                                          : nullptr;
+		if (condition)
+			throw InvalidParameter(std::string("face ") + faceName(f) + " lies across the periodic axis " + axisName(f / 2) + " but carries " + condition +
+			                       ": the faces of a periodic axis are no walls and keep the defaults (free solid and water, no inflow, drained pressure, friction or water table)");
+	}
+}
 
 NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& bcs, int i, int j, int k)
 {

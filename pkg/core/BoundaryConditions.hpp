@@ -61,6 +61,10 @@ struct BoundaryConditions {
 	// Per axis: the domain repeats along it (theory.md §2.7), points leaving through one face enter
 	// through the other and the two faces are no walls (their conditions must stay the defaults).
 	std::array<bool, 3> periodic { false, false, false };
+
+	// Throws InvalidParameter naming the face and the condition if a face of a periodic axis
+	// carries any wall condition (it would be silently ignored).
+	void requireFreePeriodicFaces() const;
 };
 
 // Which velocity components are held at zero at one node, per phase.

@@ -30,7 +30,7 @@ GridGeometry GridGeometry::forDomain(const Vec3& lower, const Vec3& upper, Real 
 		// one cell would make a stencil's nodes coincide after wrapping (3 GIMP nodes on one node)
 		if (periodic[d] && whole < 3) {
 			std::ostringstream msg;
-			msg << "periodic axis " << d << " has " << whole << " cells; it needs at least 3 (the GIMP stencil)";
+			msg << "periodic axis " << axisName(d) << " has " << whole << " cells; it needs at least 3 (the GIMP stencil)";
 			throw InvalidParameter(msg.str());
 		}
 	}

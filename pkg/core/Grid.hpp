@@ -11,6 +11,13 @@ namespace mpm {
 // Faces of the domain box, in this order wherever faces are indexed.
 enum class Face { XMin = 0, XMax = 1, YMin = 2, YMax = 3, ZMin = 4, ZMax = 5 };
 constexpr int faceCount = 6;
+// How messages name face f (0..5) and axis d (0..2).
+inline const char* faceName(int f)
+{
+	static constexpr const char* names[faceCount] = { "xMin", "xMax", "yMin", "yMax", "zMin", "zMax" };
+	return names[f];
+}
+inline char        axisName(int d) { return "xyz"[d]; }
 
 // The grid covers the domain box [lower, upper] plus one padding cell on every side, so that
 // GIMP supports (reach h + l_p) of points inside the box always find their nodes.

@@ -70,18 +70,10 @@ TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& setti
         , grid_(GridGeometry::forDomain(domain.lower, domain.upper, domain.cellSize, domain.boundaries.periodic))
 {
 	settings_.validate();
-	// the two faces of a periodic axis are no walls: a condition set on them would be silently ignored
-	const WallConditions noWall {};
-	for (int f = 0; f < faceCount; ++f) {
-		const WallConditions& w = domain_.boundaries.walls[f];
-		if (domain_.boundaries.periodic[f / 2] &&
-		    (w.solid != noWall.solid || w.water != noWall.water || w.inflow || w.drainedPressure != 0 || w.friction != 0 || w.waterTable != noWall.waterTable))
-			throw InvalidParameter("face " + std::to_string(f) + " (0..5 = xMin..zMax) lies across the periodic axis " + std::to_string(f / 2) +
-			                       ": its wall conditions must stay free (solid Free, water Free, no inflow, no drained pressure, friction or water table)");
-	}
+	domain_.boundaries.requireFreePeriodicFaces();
 	for (int f = 0; f < faceCount; ++f)
 		if (domain_.boundaries.walls[f].inflow && domain_.boundaries.walls[f].water != WaterWall::Drained)
-			throw InvalidParameter("the inflow face " + std::to_string(f) + " (0..5 = xMin..zMax) must be a drained water wall");
+			throw InvalidParameter(std::string("the inflow face ") + faceName(f) + " must be a drained water wall");
 	fields_.resize(grid_.nodeCount());
 	constrained_ = ConstrainedNodes::build(grid_, domain.boundaries);
 }

@@ -14,7 +14,6 @@
 namespace yade_mpm {
 
 namespace {
-	constexpr const char* faceNames[6] = { "xMin", "xMax", "yMin", "yMax", "zMin", "zMax" };
 
 	// Map a user's option name to the core enum; unknown names are refused listing the valid ones.
 	template <class Enum, std::size_t N>
@@ -56,38 +55,22 @@ mpm::Domain MpmTwoPhaseEngine::domain() const
 	d.cellSize = cellSize;
 	for (int f = 0; f < 6; ++f) {
 		auto& wall           = d.boundaries.walls[f];
-		wall.solid           = parseOption("solidWalls[" + std::string(faceNames[f]) + "]", solidWalls[f], solidWallOptions);
-		wall.water           = parseOption("waterWalls[" + std::string(faceNames[f]) + "]", waterWalls[f], waterWallOptions);
+		wall.solid           = parseOption("solidWalls[" + std::string(mpm::faceName(f)) + "]", solidWalls[f], solidWallOptions);
+		wall.water           = parseOption("waterWalls[" + std::string(mpm::faceName(f)) + "]", waterWalls[f], waterWallOptions);
 		wall.drainedPressure = drainedPressure[f];
 		wall.friction        = wallFriction[f];
-		if (!(wall.friction >= 0 && std::isfinite(wall.friction))) mpm::throwOutOfRange("wallFriction[" + std::string(faceNames[f]) + "]", wall.friction, "", "[0, inf)");
+		if (!(wall.friction >= 0 && std::isfinite(wall.friction))) mpm::throwOutOfRange("wallFriction[" + std::string(mpm::faceName(f)) + "]", wall.friction, "", "[0, inf)");
 		wall.waterTable      = drainedWaterTable[f];
 		wall.inflow          = waterInflow[f] != 0;
 		if (wall.inflow && wall.water != mpm::WaterWall::Drained)
-			throw mpm::InvalidParameter("waterInflow[" + std::string(faceNames[f]) + "] is set but waterWalls[" + faceNames[f] + "] = '" + waterWalls[f] +
+			throw mpm::InvalidParameter("waterInflow[" + std::string(mpm::faceName(f)) + "] is set but waterWalls[" + mpm::faceName(f) + "] = '" + waterWalls[f] +
 			                            "': inflow needs a 'drained' face");
 		if (!(wall.waterTable < std::numeric_limits<yade::Real>::infinity()))
-			mpm::throwOutOfRange("drainedWaterTable[" + std::string(faceNames[f]) + "]", wall.waterTable, "m", "[-inf (none), inf)");
-		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + std::string(faceNames[f]) + "]", wall.drainedPressure, "Pa", "finite values");
+			mpm::throwOutOfRange("drainedWaterTable[" + std::string(mpm::faceName(f)) + "]", wall.waterTable, "m", "[-inf (none), inf)");
+		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + std::string(mpm::faceName(f)) + "]", wall.drainedPressure, "Pa", "finite values");
 	}
-	for (int axis = 0; axis < 3; ++axis) {
-		d.boundaries.periodic[axis] = periodic[axis] != 0;
-		if (!d.boundaries.periodic[axis]) continue;
-		const mpm::WallConditions noWall {};
-		for (int f = 2 * axis; f <= 2 * axis + 1; ++f) {
-			const auto& wall   = d.boundaries.walls[f];
-			const auto  refuse = [&](const std::string& attribute, const std::string& value) {
-				throw mpm::InvalidParameter("periodic[" + std::string(1, "xyz"[axis]) + "] is set but " + attribute + "[" + faceNames[f] + "] = " + value +
-				                            ": the faces of a periodic axis are no walls and keep the defaults ('free', no inflow, 0 pressure and friction, no water table)");
-			};
-			if (wall.solid != noWall.solid) refuse("solidWalls", "'" + solidWalls[f] + "'");
-			if (wall.water != noWall.water) refuse("waterWalls", "'" + waterWalls[f] + "'");
-			if (wall.inflow) refuse("waterInflow", "True");
-			if (wall.drainedPressure != noWall.drainedPressure) refuse("drainedPressure", std::to_string(wall.drainedPressure));
-			if (wall.friction != noWall.friction) refuse("wallFriction", std::to_string(wall.friction));
-			if (wall.waterTable != noWall.waterTable) refuse("drainedWaterTable", std::to_string(wall.waterTable));
-		}
-	}
+	for (int axis = 0; axis < 3; ++axis) d.boundaries.periodic[axis] = periodic[axis] != 0;
+	d.boundaries.requireFreePeriodicFaces();
 	d.removeWaterLeavingGrid = removeWaterLeavingGrid;
 	d.removeFreeWater        = removeFreeWater;
 	if (waterSinks.size() % 2) throw mpm::InvalidParameter("waterSinks must hold (lower, upper) corner pairs; it has " + std::to_string(waterSinks.size()) + " corners");

@@ -161,7 +161,9 @@ void expectStandsBelowAndSlidesAbove(bool wet, double baseFriction = 0)
 	// of the block that carries its water, 0.95 of the skeleton alone: the drag of k ≈ 1 m/s carries a
 	// little of the water); a band inside (rough base) needs some slip to form first (measured 0.75
 	// dry and 0.48 wet of the skeleton alone), so only the contact is bounded from below.
-	if (baseFriction > 0) EXPECT_GE(sliding.surfaceDisplacement, 0.95 * block.waterCarried);
+	if (baseFriction > 0) {
+		EXPECT_GE(sliding.surfaceDisplacement, 0.95 * block.waterCarried);
+	}
 }
 
 TEST(InfiniteSlope, DryLayerStandsBelowAndSlidesAboveTheFrictionAngle) { expectStandsBelowAndSlidesAbove(false); }

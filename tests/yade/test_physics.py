@@ -246,10 +246,10 @@ def test_periodic_axis_carries_a_saturated_block_across_the_seam_unstrained():
 
 def test_periodic_axis_refuses_walls_on_its_faces():
     engine = w.MpmTwoPhaseEngine(domainMin=(0, 0, 0), domainMax=(0.4, 0.1, 0.1), cellSize=0.05, solidWalls=("free",) * 2 + ("slip",) * 4)
-    with pytest.raises(ValueError, match=r"periodic\[y\] is set but solidWalls\[yMin\] = 'slip'"):
+    with pytest.raises(ValueError, match=r"face yMin lies across the periodic axis y but carries a solid wall"):
         engine.periodic = (False, True, False)
     engine.periodic = (True, False, False)
-    with pytest.raises(ValueError, match=r"periodic\[x\] is set but waterWalls\[xMin\] = 'drained'"):
+    with pytest.raises(ValueError, match=r"face xMin lies across the periodic axis x but carries a water wall"):
         engine.waterWalls = ("drained",) + ("free",) * 5
     with pytest.raises(ValueError, match=r"'periodic' expects 3 entries \(x, y, z\)"):
         engine.periodic = (True, False)
