@@ -103,6 +103,33 @@ inline PressureNode& operator+=(PressureNode& a, const PressureNode& b)
 	return a;
 }
 
+// Volume-weighted moments of one set's water points in one grid cell, about the cell centre x_c
+// (edge pressure smoothing, theory.md eq. 4.17c).
+// Free-surface points are left out.
+struct PressureCell {
+	Real volume;         // Σ V [m³]
+	Vec3 offset;         // Σ V (x − x_c) [m⁴]
+	Mat3 offsetSquare;   // Σ V (x − x_c)(x − x_c)ᵀ [m⁵]
+	Real pressure;       // Σ V p [Pa m³]
+	Vec3 pressureOffset; // Σ V p (x − x_c) [Pa m⁴]
+};
+
+inline PressureCell& operator+=(PressureCell& a, const PressureCell& b)
+{
+	a.volume += b.volume;
+	a.offset += b.offset;
+	a.offsetSquare += b.offsetSquare;
+	a.pressure += b.pressure;
+	a.pressureOffset += b.pressureOffset;
+	return a;
+}
+
+// Least-squares linear pressure field p(x) = value + gradient·(x − x_c) around a cell (eq. 4.17c).
+struct PressureFit {
+	Real value;    // at the cell centre [Pa]
+	Vec3 gradient; // [Pa m⁻¹]
+};
+
 inline SolidNode& operator+=(SolidNode& a, const SolidNode& b)
 {
 	a.mass += b.mass;

@@ -48,7 +48,21 @@ struct ScatterWorkspace {
 	std::vector<MomentumNode>              remap; // Σ S m v and Σ S m at the moved points (step 8)
 	std::vector<std::vector<MomentumNode>> momentum;
 	std::vector<std::vector<PressureNode>> pressure;
+	std::vector<std::vector<PressureCell>> pressureCells;
 	std::vector<Vec3>                      contactVelocity; // the contact nodes' velocity kept through the re-map
+};
+
+// Scratch of the pressure-mode damping (eqs. 4.17b–c): per grid node or cell (cells are indexed by
+// their lower node) and per water point.
+struct PressureModeScratch {
+	enum Kind : char { Interior, Edge, FreeSurface };
+	std::vector<PressureNode> nodes;
+	std::vector<PressureCell> cells;
+	std::vector<PressureFit>  fits;
+	std::vector<char>         cellHasFit;
+	std::vector<std::size_t>  fitCells;
+	std::vector<Kind>         kind;
+	std::vector<Real>         smoothed; // p̃ of the interior points
 };
 
 // Grid nodes whose velocity has at least one constrained component, and the constraint.
@@ -120,14 +134,18 @@ namespace stages {
 	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& points, std::vector<Real>& values, std::vector<Real>& cellSum,
 	                      std::vector<Real>& cellVolume);
 
-	// Pressure-mode damping (theory.md eq. 4.17b): p ← p + r (p̃ − p), with p̃ = Σ S_I p_I the
-	// interpolation of the nodal means p_I = Σ S V p / Σ S V, on points whose stencil nodes all lie
-	// in the material's interior (full water support, off the wall planes), where p̃ = p for any
-	// linear field: hydrostatic and steady-seepage states are untouched, while modes that exert no
-	// nodal force (cell and node checkerboards) decay. `nodes` is scratch of grid.nodeCount().
+	// Pressure-mode damping (theory.md eqs. 4.17b–c): p ← p + r (p̃ − p). On points whose stencil
+	// nodes all lie in the material's interior (full water support, off the wall planes) p̃ = Σ S_I p_I,
+	// the interpolation of the nodal means p_I = Σ S V p / Σ S V, with r = `relax`; on every other
+	// point (wall, face and surface cells) p̃ is the least-squares linear fit of p over the points of
+	// the 3×3×3 cells around the point's cell, with r = `edgeRelax`;
+	// free-surface points (filling below `freeSurfaceThreshold`, 0: none) are neither fitted nor
+	// relaxed. Both reproduce any linear field:
+	// hydrostatic and steady-seepage states are untouched, while modes that exert no nodal force
+	// (cell and node checkerboards) decay.
 	template <class Kernel>
-	void dampPressureModes(const GridGeometry& grid, const GridFields& fields, Real relax, WaterPointSet& points, std::vector<PressureNode>& nodes,
-	                       ScatterWorkspace& workspace);
+	void dampPressureModes(const GridGeometry& grid, const GridFields& fields, Real relax, Real edgeRelax, Real freeSurfaceThreshold,
+	                       WaterPointSet& points, PressureModeScratch& scratch, ScatterWorkspace& workspace);
 
 	// Step 9 (theory.md eqs. 4.14–4.15, §7): deformation gradient, volume, Jaumann elastic trial
 	// stress, return mapping of the set's skeleton model, porosity; `volumetricRate` (one per

@@ -11,6 +11,15 @@ namespace mpm {
 
 namespace {
 	constexpr double inf = std::numeric_limits<double>::infinity();
+	// Rate of the edge smoothing (eq. 4.17c) as a share of the interior one, c_v/h². Relaxing towards
+	// a 3-cell linear fit also flattens a smooth curved field: it adds about share/3 × c_v to the
+	// consolidation diffusivity, so 0.03 keeps that below 1% while still damping the cell modes of
+	// the sand pile ~20× faster than they grew (theory.md eq. 4.17c).
+	constexpr double edgeDampingShare = 0.03;
+	// The linear fit is not a symmetric smoother (one-sided at edges, extrapolated to free-surface
+	// points): relaxing more than ~0.2 of the way per step made the drained infinite slope
+	// (c_v Δt/h² ≈ 27) blow up, 0.135 did not. Per-step cap, with margin [-].
+	constexpr double edgeRelaxLimit = 0.05;
 
 	// Times one stage into its slot of `seconds`.
 	class StageTimer {
@@ -245,8 +254,9 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 			}
 			updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
 			if (settings_.pressureModeDamping && pressureDiffusivity_ > 0) {
-				const Real relax = std::min<Real>(1, dt * pressureDiffusivity_ / (grid_.cellSize * grid_.cellSize));
-				dampPressureModes<Kernel>(grid_, fields_, relax, *w, pressureNodes_, workspace_);
+				const Real rate = dt * pressureDiffusivity_ / (grid_.cellSize * grid_.cellSize);
+				dampPressureModes<Kernel>(grid_, fields_, std::min<Real>(1, rate), std::min<Real>(edgeRelaxLimit, edgeDampingShare * rate),
+				                          settings_.freeSurfaceThreshold, *w, pressureModes_, workspace_);
 			}
 			if (settings_.freeSurfaceThreshold > 0) applyFreeSurface(grid_, fields_, settings_.freeSurfaceThreshold, settings_.freeSurfaceHoldsSuction, *w);
 			applyDrainedFaces(grid_, domain_.boundaries, settings_.gravity, water_.density, *w);

@@ -119,7 +119,7 @@ private:
 	void                          removeOutflowingWater();
 	std::vector<char>             removeFlags_;
 	std::vector<char>             suctionHolding_; // nodes of the suction-holding free surface (eq. 2.3b)
-	std::vector<PressureNode>     pressureNodes_; // scratch of eq. 4.17b
+	PressureModeScratch           pressureModes_; // scratch of eqs. 4.17b–c
 	Real                          pressureDiffusivity_ = 0; // c_v [m² s⁻¹] of eq. 4.17b
 	std::array<double, static_cast<int>(Stage::Count)> stageSeconds_ {};
 };

@@ -189,7 +189,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		stringAttr("drag", &E::drag, "Drag integration [-]: 'semi-implicit' (no drag time-step limit) or 'explicit'"),
 		boolAttr("cellAveraging", &E::cellAveraging, "Cell-averaged volumetric rates for the pore pressure and the skeleton (suppresses the pressure checkerboard) [-]"),
 		boolAttr("pressureModeDamping", &E::pressureModeDamping,
-		         "Pore-pressure modes the grid cannot see (cell and node checkerboards, which exert no nodal force and so are never drained) relax towards the nodal average at the rate c_v/h² at which seepage drains a one-cell perturbation (theory.md eq. 4.17b); off, they can grow without bound in long runs [-]"),
+		         "Pore-pressure modes the grid cannot see (cell and node checkerboards, which exert no nodal force and so are never drained) relax towards the nodal average at the rate c_v/h² at which seepage drains a one-cell perturbation (theory.md eq. 4.17b), and in wall, face and surface cells towards a local linear fit at a slower rate (eq. 4.17c); off, they can grow without bound in long runs [-]"),
 		realAttr("freeSurfaceThreshold", &E::freeSurfaceThreshold,
 		         "Free-surface detection β [-], 0 ≤ β < 1: water points whose filling Σ S V_water/V_full of their nodes is below β get p = 0 (0.75 keeps exactly the outer layer with 2 points per cell and axis); 0: off"),
 		boolAttr("freeSurfaceHoldsSuction", &E::freeSurfaceHoldsSuction,
