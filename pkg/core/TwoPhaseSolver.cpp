@@ -16,9 +16,9 @@ namespace {
 	// consolidation diffusivity, so 0.03 keeps that below 1% while still damping the cell modes of
 	// the sand pile ~20× faster than they grew (theory.md eq. 4.17c).
 	constexpr double edgeDampingShare = 0.03;
-	// The linear fit is not a symmetric smoother (one-sided at edges, extrapolated to free-surface
-	// points): relaxing more than ~0.2 of the way per step made the drained infinite slope
-	// (c_v Δt/h² ≈ 27) blow up, 0.135 did not. Per-step cap, with margin [-].
+	// The linear fit is not a symmetric smoother (one-sided at edges): relaxing 0.27 of the way per
+	// step made the drained infinite slope (c_v Δt/h² ≈ 27) blow up, 0.135 did not (measured with a
+	// variant that also relaxed the free-surface points). Per-step cap, with margin [-].
 	constexpr double edgeRelaxLimit = 0.05;
 
 	// Times one stage into its slot of `seconds`.
