@@ -394,20 +394,26 @@ namespace stages {
 		}
 	}
 
+	// Lower node (i, j, k) of the cell holding x.
+	inline std::array<int, 3> cellOf(const GridGeometry& grid, const Vec3& x)
+	{
+		const Vec3 u = (x - grid.origin) / grid.cellSize;
+		return { static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])), static_cast<int>(std::floor(u[2])) };
+	}
+
 	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& P, std::vector<Real>& values, std::vector<Real>& cellSum,
 	                      std::vector<Real>& cellVolume)
 	{
 		const std::size_t count = P.size(), cells = grid.nodeCount();
 		cellSum.assign(cells, 0);
 		cellVolume.assign(cells, 0);
-		const Real invH     = 1 / grid.cellSize;
-		auto       cellOf   = [&](std::size_t p) {
-                        const Vec3 u = (P.position[p] - grid.origin) * invH;
-                        return grid.index(static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])), static_cast<int>(std::floor(u[2])));
+		auto cellIndex = [&](std::size_t p) {
+			const std::array<int, 3> c = cellOf(grid, P.position[p]);
+			return grid.index(c[0], c[1], c[2]);
 		};
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
-			const std::size_t c = cellOf(p);
+			const std::size_t c = cellIndex(p);
 			const Real        v = P.volume[p];
 #pragma omp atomic
 			cellSum[c] += v * values[p];
@@ -416,7 +422,7 @@ namespace stages {
 		}
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
-			const std::size_t c = cellOf(p);
+			const std::size_t c = cellIndex(p);
 			values[p]           = cellSum[c] / cellVolume[c];
 		}
 	}
@@ -439,13 +445,6 @@ namespace stages {
 					filling += N * (expected > 0 ? fields.water[grid.index(i, j, k)].volume / expected : 1.0);
 				}
 		return filling;
-	}
-
-	// Lower node (i, j, k) of the cell holding x.
-	inline std::array<int, 3> cellOf(const GridGeometry& grid, const Vec3& x)
-	{
-		const Vec3 u = (x - grid.origin) / grid.cellSize;
-		return { static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])), static_cast<int>(std::floor(u[2])) };
 	}
 
 	// Linear least-squares fit of the pressures of the points in the 3×3×3 cells around `cell`
@@ -657,12 +656,15 @@ namespace stages {
 		}
 	}
 
-	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& P)
+	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& P,
+	                      const std::vector<PressureModeScratch::Kind>* kinds)
 	{
 		const std::size_t count = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t p = 0; p < count; ++p)
-			if (waterFilling(grid, fields, P.position[p], P.halfLength[p]) < threshold) P.porePressure[p] = keepSuction ? std::min<Real>(P.porePressure[p], 0) : 0;
+		for (std::size_t p = 0; p < count; ++p) {
+			const bool surface = kinds ? (*kinds)[p] == PressureModeScratch::FreeSurface : waterFilling(grid, fields, P.position[p], P.halfLength[p]) < threshold;
+			if (surface) P.porePressure[p] = keepSuction ? std::min<Real>(P.porePressure[p], 0) : 0;
+		}
 	}
 
 	void updateDomainsCpGimp(SolidPointSet& P, Real cellSize)

@@ -166,7 +166,10 @@ namespace stages {
 	// (nodal water-point volume over the node's full in-domain support volume) is below `threshold`;
 	// with 2 points per cell and axis the outer layer has 0.625 and the next 0.875. With
 	// `keepSuction` only positive pressures are released, p = min(p, 0) (a seepage face, eq. 2.3b).
-	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& points);
+	// `kinds`, when given, is the classification the pressure-mode damping made this step with the
+	// same threshold (its FreeSurface points are those below it), so the fillings are not recomputed.
+	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& points,
+	                      const std::vector<PressureModeScratch::Kind>* kinds = nullptr);
 
 	// Step 11 (theory.md eq. 3.3): cpGIMP domains follow the stretch, l_i = l0_i F_ii in [0.01 h, h/2].
 	void updateDomainsCpGimp(SolidPointSet& points, Real cellSize);

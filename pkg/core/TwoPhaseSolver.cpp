@@ -253,12 +253,14 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 				averageOverCells(grid_, *w, waterDivergence_, cellSum_, cellVolume_);
 			}
 			updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
-			if (settings_.pressureModeDamping && pressureDiffusivity_ > 0) {
+			const bool damped = settings_.pressureModeDamping && pressureDiffusivity_ > 0;
+			if (damped) {
 				const Real rate = dt * pressureDiffusivity_ / (grid_.cellSize * grid_.cellSize);
 				dampPressureModes<Kernel>(grid_, fields_, std::min<Real>(1, rate), std::min<Real>(edgeRelaxLimit, edgeDampingShare * rate),
 				                          settings_.freeSurfaceThreshold, *w, pressureModes_, workspace_);
 			}
-			if (settings_.freeSurfaceThreshold > 0) applyFreeSurface(grid_, fields_, settings_.freeSurfaceThreshold, settings_.freeSurfaceHoldsSuction, *w);
+			if (settings_.freeSurfaceThreshold > 0)
+				applyFreeSurface(grid_, fields_, settings_.freeSurfaceThreshold, settings_.freeSurfaceHoldsSuction, *w, damped ? &pressureModes_.kind : nullptr);
 			applyDrainedFaces(grid_, domain_.boundaries, settings_.gravity, water_.density, *w);
 		}
 	}
