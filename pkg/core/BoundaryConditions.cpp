@@ -4,6 +4,7 @@
 #include "Grid.hpp"
 #include "PointSets.hpp"
 
+#include <functional>
 #include <string>
 
 namespace mpm {
@@ -59,8 +60,8 @@ NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& 
 	return c;
 }
 
-void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, Real waterMassTolerance,
-                             GridFields& fields)
+void forEachDrainedFaceTraction(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, Real waterMassTolerance,
+                                 const GridFields& fields, const std::function<void(std::size_t, const Vec3&)>& apply)
 {
 	const Real h = grid.cellSize;
 	for (int face = 0; face < faceCount; ++face) {
@@ -87,11 +88,18 @@ void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions&
 				Vec3 centroid = grid.nodePosition(idx[0], idx[1], idx[2]);
 				centroid[a1] += centroidShift(a1, j);
 				centroid[a2] += centroidShift(a2, k);
-				const Vec3 traction = wall.drainedPressureAt(centroid, gravity, waterDensity) * area * inward;
-				fields.water[I].porousForce += fields.porosity[I] * traction;
-				fields.water[I].pressureForce += traction;
+				apply(I, wall.drainedPressureAt(centroid, gravity, waterDensity) * area * inward);
 			}
 	}
+}
+
+void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, Real waterMassTolerance,
+                             GridFields& fields)
+{
+	forEachDrainedFaceTraction(grid, bcs, gravity, waterDensity, waterMassTolerance, fields, [&](std::size_t I, const Vec3& traction) {
+		fields.water[I].porousForce += fields.porosity[I] * traction;
+		fields.water[I].pressureForce += traction;
+	});
 }
 
 void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, WaterPointSet& points)

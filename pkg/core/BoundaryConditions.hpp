@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 namespace mpm {
@@ -88,6 +89,9 @@ struct GridFields;
 // water and −∮ N p̄ n̂ dA on the mixture, at the wall-plane nodes that carry water.
 void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, Real waterMassTolerance,
                              GridFields& fields);
+// The same tractions −∮ N p̄ n̂ dA per wall-plane node carrying water, handed to `apply(node, traction [N])`.
+void forEachDrainedFaceTraction(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, Real waterMassTolerance,
+                                const GridFields& fields, const std::function<void(std::size_t, const Vec3&)>& apply);
 
 // Hold the pore pressure of water points at Drained faces (theory.md §2, eq. 2.1).
 void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, WaterPointSet& points);

@@ -28,7 +28,8 @@ Real SoilParameters::constrainedModulus() const
 void WaterParameters::validate() const
 {
 	requireOpenRange("density", density, 0, inf, "kg m⁻³");
-	requireOpenRange("bulkModulus", bulkModulus, 0, inf, "Pa");
+	// inf: incompressible water (semi-implicit scheme only, checked by the solver)
+	if (!(bulkModulus > 0)) throwOutOfRange("bulkModulus", bulkModulus, "Pa", "(0, inf]");
 	requireOpenRange("viscosity", viscosity, 0, inf, "Pa s");
 }
 

@@ -23,7 +23,7 @@ struct SoilParameters {
 // Pore water (doc/theory.md §1).
 struct WaterParameters {
 	Real density     = 1000;  // ρw [kg m⁻³], > 0
-	Real bulkModulus = 2.2e9; // Kw [Pa], > 0
+	Real bulkModulus = 2.2e9; // Kw [Pa], in (0, inf]; inf: incompressible (semi-implicit scheme only)
 	Real viscosity   = 1e-3;  // μw [Pa s], > 0
 
 	void validate() const;

@@ -1,5 +1,7 @@
 #include "Stages.hpp"
 
+#include "Stencil.hpp"
+
 #include <omp.h>
 
 #include <Eigen/Eigenvalues>
@@ -10,86 +12,37 @@
 namespace mpm {
 
 namespace {
-
-	// Shape-function weights of one point along the three axes (theory.md eq. 3.2).
-	template <class Kernel> inline void weightsAt(const GridGeometry& g, const Vec3& x, const Vec3& halfLength, Weights1D (&w)[3])
-	{
-		const Real invH = 1 / g.cellSize;
-		for (int d = 0; d < 3; ++d) Kernel::evaluate((x[d] - g.origin[d]) * invH, std::min<Real>(halfLength[d] * invH, 0.5), invH, w[d]);
-	}
-
-	// Node indices of the stencil per axis, wrapped along periodic axes (theory.md §2.7):
-	// node[d][a] is the a-th stencil node along axis d.
-	template <int S> inline void stencilNodes(const GridGeometry& g, const Weights1D (&w)[3], int (&node)[3][S])
-	{
-		for (int d = 0; d < 3; ++d)
-			for (int a = 0; a < S; ++a) node[d][a] = g.wrap(d, w[d].first + a);
-	}
-
-	// Call f(node, S, ∇S) for every node of the point's stencil (tensor product).
-	template <class Kernel, class F> inline void forEachNode(const GridGeometry& g, const Weights1D (&w)[3], F&& f)
-	{
-		constexpr int S = Kernel::stencil;
-		int           node[3][S];
-		stencilNodes(g, w, node);
-		for (int c = 0; c < S; ++c)
-			for (int b = 0; b < S; ++b) {
-				const Real        vyz  = w[1].value[b] * w[2].value[c];
-				const Real        gyz  = w[1].gradient[b] * w[2].value[c];
-				const Real        vygz = w[1].value[b] * w[2].gradient[c];
-				const std::size_t row  = g.index(0, node[1][b], node[2][c]);
-				for (int a = 0; a < S; ++a) {
-					const Real N = w[0].value[a] * vyz;
-					if (N == 0 && w[0].gradient[a] == 0) continue;
-					f(row + node[0][a], N, Vec3(w[0].gradient[a] * vyz, w[0].value[a] * gyz, w[0].value[a] * vygz));
-				}
-			}
-	}
-
-	// A periodic coordinate brought back into [lower, upper) (theory.md §2.7)
-	inline void wrapPosition(const GridGeometry& g, Vec3& x)
-	{
-		for (int d = 0; d < 3; ++d) {
-			if (!g.periodic[d]) continue;
-			const Real lower = g.origin[d] + g.wallNode[d] * g.cellSize, length = (g.upperWallNode[d] - g.wallNode[d]) * g.cellSize;
-			x[d] -= length * std::floor((x[d] - lower) / length);
-			if (x[d] >= lower + length) x[d] -= length; // round-off of the line above
-		}
-	}
-
-	// Race-free scatter: thread 0 adds into `target`, the others into private copies that are
-	// then summed node by node. Results differ between thread counts only by round-off.
-	inline SolidNode zeroOf(const SolidNode&) { return SolidNode { 0, Vec3::Zero(), Vec3::Zero(), 0, 0, 0 }; }
-	inline WaterNode zeroOf(const WaterNode&) { return WaterNode { 0, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0, 0 }; }
-	inline Vec3      zeroOf(const Vec3&) { return Vec3::Zero(); }
-	inline PressureNode zeroOf(const PressureNode&) { return PressureNode { 0, 0 }; }
-	inline PressureCell zeroOf(const PressureCell&) { return PressureCell { 0, Vec3::Zero(), Mat3::Zero(), 0, Vec3::Zero() }; }
-	inline MomentumNode zeroOf(const MomentumNode&) { return MomentumNode { Vec3::Zero(), 0 }; }
-
-	template <class Node, class F> void scatter(std::vector<Node>& target, std::vector<std::vector<Node>>& buffers, std::size_t count, F&& perPoint)
-	{
-		const int threads = count <= parallelThreshold ? 1 : omp_get_max_threads();
-		if (threads == 1) {
-			for (std::size_t p = 0; p < count; ++p) perPoint(p, target.data());
-			return;
-		}
-		buffers.resize(threads - 1);
-		for (auto& b : buffers) b.assign(target.size(), zeroOf(Node {}));
-#pragma omp parallel num_threads(threads)
-		{
-			const int tid = omp_get_thread_num();
-			Node*     dst = tid == 0 ? target.data() : buffers[tid - 1].data();
-#pragma omp for schedule(static)
-			for (std::size_t p = 0; p < count; ++p) perPoint(p, dst);
-		}
-		const std::size_t nodes = target.size();
-#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
-		for (std::size_t i = 0; i < nodes; ++i)
-			for (auto& b : buffers) target[i] += b[i];
-	}
+	using namespace detail;
 
 	// Kozeny–Carman permeability ratio κ(n)/κ0 (theory.md eq. 1.7).
 	inline Real kozenyCarmanRatio(Real n, Real n0) { return (n * n * n / ((1 - n) * (1 - n))) / (n0 * n0 * n0 / ((1 - n0) * (1 - n0))); }
+
+	// Effective normal force N' of the grains on a frictional wall normal to axis d at node i
+	// (theory.md eq. 2.6): −n̂·f', f' the effective-stress force plus the buoyant weight of the
+	// node's grains (their weight less Archimedes' share (1−n)/n of the water weight). The mapped
+	// momentum is left out: at a held wall node it is the interior's velocity smeared onto the wall
+	// by the mapping, not an impact.
+	inline Real contactNormalForce(const GridFields& fields, std::size_t i, const NodeConstraint& nc, int d, bool hasWater)
+	{
+		const SolidNode& s          = fields.solid[i];
+		const Real       n          = hasWater ? fields.porosity[i] : 1; // porosity is mapped only in wet scenes
+		const Real       solidForce = hasWater && n > 0 ? s.mixtureForce[d] - ((1 - n) / n) * fields.water[i].weight[d] : s.mixtureForce[d];
+		return -nc.inward[d] * solidForce;
+	}
+
+	// Coulomb (eq. 2.6): the tangential impulse on a held contact node is at most μ N' Δt; the
+	// solid sticks below it and slides slower above it. Components held by other walls are zero.
+	inline void applyCoulombFriction(const NodeConstraint& nc, const std::array<bool, 3>& held, const std::array<Real, 3>& normalForce, Real dtOverMass,
+	                                 Vec3& vs)
+	{
+		for (int d = 0; d < 3; ++d) {
+			if (!(held[d] && nc.friction[d] > 0)) continue;
+			Vec3 tangential = vs;
+			tangential[d]   = 0;
+			const Real speed = tangential.norm(), limit = nc.friction[d] * normalForce[d] * dtOverMass;
+			vs -= speed <= limit ? tangential : Vec3((limit / speed) * tangential);
+		}
+	}
 
 	inline void applyConstraint(const std::array<bool, 3>& fixed, Vec3& v)
 	{
@@ -168,7 +121,8 @@ namespace stages {
 	}
 
 	template <class Kernel>
-	void mapWaterToGrid(const GridGeometry& grid, std::vector<WaterPointSet*>& sets, const Vec3& gravity, GridFields& fields, ScatterWorkspace& workspace)
+	void mapWaterToGrid(const GridGeometry& grid, std::vector<WaterPointSet*>& sets, const Vec3& gravity, GridFields& fields, ScatterWorkspace& workspace,
+	                    bool pressureForces)
 	{
 		const std::vector<Real>& nodalPorosity = fields.porosity;
 		for (WaterPointSet* set : sets) {
@@ -185,7 +139,7 @@ namespace stages {
 				});
 				n              = std::clamp<Real>(n, 1e-5, 1);
 				P.porosity[p]  = n;
-				const Real m = P.mass[p], V = P.volume[p], pressure = P.porePressure[p];
+				const Real m = P.mass[p], V = P.volume[p], pressure = pressureForces ? P.porePressure[p] : 0;
 				const Vec3 weight = m * gravity;
 				const Vec3 mv     = m * P.velocity[p];
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
@@ -232,7 +186,8 @@ namespace stages {
 	}
 
 	void integrateNodalMomentum(GridFields& fields, const ConstrainedNodes& constrained, Real dt, DragScheme drag, Real solidMassTolerance,
-	                            Real waterMassTolerance, const std::vector<char>* suctionHolding)
+	                            Real waterMassTolerance, const std::vector<char>* suctionHolding, bool friction,
+	                            std::vector<std::array<bool, 3>>* heldSolid)
 	{
 		const std::size_t nodes = fields.solid.size();
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
@@ -266,6 +221,7 @@ namespace stages {
 		// Walls (theory.md §2): a held component is zero; the other phase's free component is
 		// then re-solved with it known (water: drag to the held solid; solid: mixture momentum).
 		const std::size_t count = constrained.node.size();
+		if (heldSolid) heldSolid->resize(count);
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t c = 0; c < count; ++c) {
 			const std::size_t     i  = constrained.node[c];
@@ -277,26 +233,19 @@ namespace stages {
 			Vec3&      vwNew = fields.waterVelocityNew[i];
 			const Vec3 fm = s.mixtureForce + w.pressureForce + w.weight, fw = w.porousForce + w.weight;
 			const bool holding = hasS && hasW && suctionHolding && (*suctionHolding)[i];
-			// A frictional wall is a contact (theory.md eq. 2.6): it pushes the grains with the
-			// effective normal force N' = −n̂·f', f' the effective-stress force plus the buoyant
-			// weight of the node's grains (their weight less Archimedes' share of the water weight,
-			// (1−n)/n of it), and lets them go where N' ≤ 0 and they move off the wall (lift-off:
-			// no normal constraint, no friction). The mapped momentum is left out of N': at a held
-			// wall node it is the interior's velocity smeared onto the wall by the mapping, not an
-			// impact.
-			NodeConstraint active = nc;
+			// A frictional wall is a contact (eq. 2.6): released only where N' ≤ 0 and the grains
+			// move off the wall; a node pulled off but carried towards the wall by its momentum
+			// stays held (else it would pass the wall)
+			NodeConstraint      active = nc;
 			std::array<Real, 3> normalForce { 0, 0, 0 };
 			if (hasS)
 				for (int d = 0; d < 3; ++d) {
 					if (nc.inward[d] == 0) continue;
-					const Real n          = hasW ? fields.porosity[i] : 1; // porosity is mapped only in wet scenes
-					const Real solidForce = hasW && n > 0 ? s.mixtureForce[d] - ((1 - n) / n) * w.weight[d] : s.mixtureForce[d];
-					normalForce[d]        = -nc.inward[d] * solidForce;
-					// released only when pulled off and moving off: a node pulled off but carried
-					// towards the wall by its momentum stays held (else it would pass the wall)
+					normalForce[d]  = contactNormalForce(fields, i, nc, d, hasW);
 					active.solid[d] = normalForce[d] > 0 || nc.inward[d] * vsNew[d] < 0;
 					normalForce[d]  = std::max<Real>(0, normalForce[d]);
 				}
+			if (heldSolid) (*heldSolid)[c] = active.solid;
 			for (int d = 0; d < 3; ++d) {
 				if (active.solid[d] || (holding && active.water[d])) vsNew[d] = 0;
 				if (active.water[d] || (holding && active.solid[d])) vwNew[d] = 0;
@@ -306,15 +255,22 @@ namespace stages {
 				if (active.solid[d]) vwNew[d] = drag == DragScheme::SemiImplicit ? (A * vw + fw[d]) / (A + Q) : vw + (dt / mw) * (fw[d] - Q * (vw - vs));
 				else vsNew[d] = vs + (dt * fm[d] - mw * (vwNew[d] - vw)) / ms;
 			}
-			// Coulomb: the tangential impulse is at most μ N' Δt; the solid sticks below it and slides
-			// slower above it. Components held by other walls are zero already.
-			for (int d = 0; d < 3; ++d) {
-				if (!(hasS && active.solid[d] && nc.friction[d] > 0)) continue;
-				Vec3 tangential = vsNew;
-				tangential[d]   = 0;
-				const Real speed = tangential.norm(), limit = nc.friction[d] * normalForce[d] * dt / s.mass;
-				vsNew -= speed <= limit ? tangential : Vec3((limit / speed) * tangential);
-			}
+			if (friction && hasS) applyCoulombFriction(nc, active.solid, normalForce, dt / s.mass, vsNew);
+		}
+	}
+
+	void applyWallFriction(GridFields& fields, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
+	                       Real solidMassTolerance, Real waterMassTolerance)
+	{
+		for (std::size_t c : constrained.contact) {
+			const std::size_t     i  = constrained.node[c];
+			const NodeConstraint& nc = constrained.constraint[c];
+			const SolidNode&      s  = fields.solid[i];
+			if (!(s.mass > solidMassTolerance)) continue;
+			std::array<Real, 3> normalForce { 0, 0, 0 };
+			for (int d = 0; d < 3; ++d)
+				if (nc.inward[d] != 0) normalForce[d] = std::max<Real>(0, contactNormalForce(fields, i, nc, d, fields.water[i].mass > waterMassTolerance));
+			applyCoulombFriction(nc, heldSolid[c], normalForce, dt / s.mass, fields.solidVelocityNew[i]);
 		}
 	}
 
@@ -693,7 +649,7 @@ namespace stages {
 #define MPM_INSTANTIATE_STAGES(K)                                                                                                          \
 	template void mapSolidToGrid<K>(const GridGeometry&, const std::vector<SolidSet>&, const WaterParameters*, const Vec3&, GridFields&,   \
 	                                ScatterWorkspace&);                                                                                    \
-	template void mapWaterToGrid<K>(const GridGeometry&, std::vector<WaterPointSet*>&, const Vec3&, GridFields&, ScatterWorkspace&);       \
+	template void mapWaterToGrid<K>(const GridGeometry&, std::vector<WaterPointSet*>&, const Vec3&, GridFields&, ScatterWorkspace&, bool); \
 	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, MaterialPointSet&,    \
 	                                       Real, Real);                                                                                    \
 	template void remapVelocities<K>(const GridGeometry&, const std::vector<const MaterialPointSet*>&, Real, const ConstrainedNodes&, bool,  \

@@ -89,9 +89,11 @@ namespace stages {
 
 	// Steps 3–4 (theory.md eqs. 4.5–4.7): porosity at water points from the nodal field, then water
 	// mass, momentum, weight, −n∇p force (incl. the porosity-gradient term) and the pressure force.
+	// `pressureForces` false leaves the pore-pressure forces out (the semi-implicit predictor: the
+	// projection supplies them from p^{n+1}, theory.md §8.3).
 	template <class Kernel>
 	void mapWaterToGrid(const GridGeometry& grid, std::vector<WaterPointSet*>& sets, const Vec3& gravity, GridFields& fields,
-	                    ScatterWorkspace& workspace);
+	                    ScatterWorkspace& workspace, bool pressureForces = true);
 
 	// Step 5: v_I = P_I / m_I for nodes above the mass tolerance, else 0.
 	void computeNodalVelocities(GridFields& fields, Real solidMassTolerance, Real waterMassTolerance);
@@ -105,8 +107,17 @@ namespace stages {
 	// Step 6 (theory.md eqs. 4.8–4.10): coupled nodal momentum of water and mixture with
 	// semi-implicit or explicit drag, then the velocity constraints of the walls. Nodes marked in
 	// `suctionHolding` (may be null) move both phases with the mixture velocity (eq. 2.3b).
+	// `friction` false leaves the Coulomb step of frictional walls to applyWallFriction (the
+	// semi-implicit step applies it once, after the pressure correction); `heldSolid`, when given,
+	// receives per constrained node the solid components held this step (contacts may release).
 	void integrateNodalMomentum(GridFields& fields, const ConstrainedNodes& constrained, Real dt, DragScheme drag,
-	                            Real solidMassTolerance, Real waterMassTolerance, const std::vector<char>* suctionHolding = nullptr);
+	                            Real solidMassTolerance, Real waterMassTolerance, const std::vector<char>* suctionHolding = nullptr,
+	                            bool friction = true, std::vector<std::array<bool, 3>>* heldSolid = nullptr);
+
+	// Coulomb friction of frictional walls (theory.md eq. 2.6) on the current new solid velocity,
+	// at the contact nodes whose normal `heldSolid` (from integrateNodalMomentum) holds.
+	void applyWallFriction(GridFields& fields, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
+	                       Real solidMassTolerance, Real waterMassTolerance);
 
 	// Step 7 (theory.md eq. 4.11): G2P with FLIP/PIC blend α; positions move with the new grid
 	// velocity. Returns the index of the first runaway point, or -1: one whose velocity is not

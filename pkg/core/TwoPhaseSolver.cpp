@@ -52,6 +52,9 @@ const char* stageName(Stage s)
 		case Stage::MapSolidToGrid: return "mapSolidToGrid";
 		case Stage::MapWaterToGrid: return "mapWaterToGrid";
 		case Stage::IntegrateNodalMomentum: return "integrateNodalMomentum";
+		case Stage::AssemblePressure: return "assemblePressure";
+		case Stage::SolvePressure: return "solvePressure";
+		case Stage::CorrectVelocities: return "correctVelocities";
 		case Stage::UpdatePointKinematics: return "updatePointKinematics";
 		case Stage::RemapVelocities: return "remapVelocities";
 		case Stage::UpdateSolidStress: return "updateSolidStress";
@@ -71,6 +74,13 @@ void SolverSettings::validate() const
 		throw InvalidParameter("freeSurfaceHoldsSuction = true needs a free surface: freeSurfaceThreshold = " + std::to_string(freeSurfaceThreshold) +
 		                       " must lie in (0, 1)");
 	if (!gravity.allFinite()) throw InvalidParameter("gravity must have finite components [m s⁻²]");
+	requireOpenRange("pressureTolerance", pressureTolerance, 0, inf, "Pa");
+	// the relaxations of eqs. 4.17b–c and the suction seal of eq. 2.3b belong to the explicit scheme;
+	// the semi-implicit one is stable without them (theory.md §8.4)
+	if (scheme == TimeScheme::SemiImplicit && pressureModeDamping)
+		throw InvalidParameter("pressureModeDamping = true is a relaxation of the explicit scheme (theory.md eq. 4.17b): it needs scheme = 'explicit'");
+	if (scheme == TimeScheme::SemiImplicit && freeSurfaceHoldsSuction)
+		throw InvalidParameter("freeSurfaceHoldsSuction = true belongs to the explicit scheme (theory.md eq. 2.3b): it needs scheme = 'explicit'");
 }
 
 TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& settings)
@@ -91,6 +101,8 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
                                const std::vector<std::string>& waterNames)
 {
 	water.validate();
+	if (!std::isfinite(water.bulkModulus) && settings_.scheme == TimeScheme::Explicit && !waters.empty())
+		throw InvalidParameter("bulkModulus = inf Pa (incompressible water) needs scheme = 'semi-implicit': the explicit step follows the water's wave");
 	Real minSolid = inf, minWater = inf;
 	for (std::size_t s = 0; s < solids.size(); ++s) {
 		solids[s].soil.validate();
@@ -120,17 +132,19 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 
 TimeStepLimits TwoPhaseSolver::timeStepLimits() const
 {
-	const bool hasWater = !waters_.empty();
+	const bool hasWater = !waters_.empty(), semiImplicit = settings_.scheme == TimeScheme::SemiImplicit;
 	const Real rhoW = water_.density, Kw = water_.bulkModulus;
-	Real       speed = hasWater ? std::sqrt(Kw / rhoW) : 0, dragLimit = inf; // water alone (free water)
-	Real       pointSpeed = 0;
+	// explicit: the water's own wave bounds free water; semi-implicit: the pressure is implicit and
+	// free water is bounded by its points' speed alone (eq. 8.10)
+	Real speed = hasWater && !semiImplicit ? std::sqrt(Kw / rhoW) : 0, dragLimit = inf;
+	Real pointSpeed = 0;
 	for (const SolidSet& set : solids_) {
 		const SoilParameters& s   = set.soil;
 		const Real            n   = s.porosity;
 		const Real            Ec  = s.constrainedModulus();
 		const Real            rhoS = (1 - n) * s.density;                       // partial density of the skeleton
-		speed                     = std::max(speed, std::sqrt(Ec / rhoS));      // skeleton alone
-		if (hasWater) {
+		speed                     = std::max(speed, std::sqrt(Ec / rhoS));      // skeleton alone (eqs. 5.1, 8.10)
+		if (hasWater && !semiImplicit) {
 			const Real rhoSat = rhoS + n * rhoW;
 			speed             = std::max(speed, std::sqrt((Ec + Kw / n) / rhoSat)); // undrained P wave
 			if (settings_.drag == DragScheme::Explicit) {
@@ -173,7 +187,9 @@ void TwoPhaseSolver::step(Real dt)
 	++steps_;
 }
 
-// The explicit step, MUSL with FLIP/PIC blend (theory.md §4, Steps 0–11).
+// One step, MUSL with FLIP/PIC blend: explicit (theory.md §4, Steps 0–11) or semi-implicit, where
+// Step 6 becomes predictor, pressure solve and corrector and Step 10 moves only the water volume
+// (theory.md §8.3).
 template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 {
 	using namespace stages;
@@ -191,15 +207,37 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	}
 	if (wet) {
 		StageTimer t(stageSeconds_, Stage::MapWaterToGrid);
-		mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_);
-		addDrainedFaceTractions(grid_, domain_.boundaries, g, water_.density, waterMassTolerance_, fields_);
+		mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_, settings_.scheme == TimeScheme::Explicit);
+		// semi-implicit: these are pore-pressure forces too, applied with the others in the corrector
+		if (settings_.scheme == TimeScheme::Explicit) addDrainedFaceTractions(grid_, domain_.boundaries, g, water_.density, waterMassTolerance_, fields_);
 	}
+	const bool semiImplicit = wet && settings_.scheme == TimeScheme::SemiImplicit;
 	{
-		StageTimer t(stageSeconds_, Stage::IntegrateNodalMomentum);
+		StageTimer t(stageSeconds_, Stage::IntegrateNodalMomentum); // explicit: eqs. 4.8–4.10; semi-implicit: predictor S1 (eq. 8.7)
 		computeNodalVelocities(fields_, solidMassTolerance_, waterMassTolerance_);
 		const bool holdSuction = wet && settings_.freeSurfaceHoldsSuction;
 		if (holdSuction) markSuctionHoldingNodes(grid_, fields_, settings_.freeSurfaceThreshold, solidMassTolerance_, waterMassTolerance_, suctionHolding_);
-		integrateNodalMomentum(fields_, constrained_, dt, settings_.drag, solidMassTolerance_, waterMassTolerance_, holdSuction ? &suctionHolding_ : nullptr);
+		integrateNodalMomentum(fields_, constrained_, dt, settings_.drag, solidMassTolerance_, waterMassTolerance_, holdSuction ? &suctionHolding_ : nullptr,
+		                       !semiImplicit, &heldSolid_);
+	}
+	if (semiImplicit) {
+		{
+			StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.1–8.7
+			classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, settings_.freeSurfaceThreshold, pressureSystem_);
+			assemblePressureSystem<Kernel>(grid_, fields_, waters_, water_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
+			                               pressureSystem_);
+			buildPressureMatrix(grid_, pressureSystem_);
+		}
+		{
+			StageTimer t(stageSeconds_, Stage::SolvePressure); // eq. 8.7
+			lastPressureSolve_ = solvePressure(pressureSystem_, settings_.pressureTolerance);
+		}
+		{
+			StageTimer t(stageSeconds_, Stage::CorrectVelocities); // eq. 8.8, then the wall friction (eq. 2.6) once
+			correctVelocities<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, constrained_, heldSolid_, dt, solidMassTolerance_,
+			                          waterMassTolerance_, pressureSystem_);
+			applyWallFriction(fields_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_);
+		}
 	}
 	{
 		StageTimer t(stageSeconds_, Stage::UpdatePointKinematics);
@@ -249,9 +287,11 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 		for (WaterPointSet* w : waters_) {
 			computePressureRates<Kernel>(grid_, fields_.solidVelocityNew, fields_.waterVelocityNew, *w, water_, pressureRate_, waterDivergence_);
 			if (average) {
-				averageOverCells(grid_, *w, pressureRate_, cellSum_, cellVolume_);
+				if (!semiImplicit) averageOverCells(grid_, *w, pressureRate_, cellSum_, cellVolume_);
 				averageOverCells(grid_, *w, waterDivergence_, cellSum_, cellVolume_);
 			}
+			// semi-implicit: the pressure was advanced by the projection (eq. 8.8); only the volume moves here
+			if (semiImplicit) std::fill(pressureRate_.begin(), pressureRate_.end(), 0.0);
 			updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
 			const bool damped = settings_.pressureModeDamping && pressureDiffusivity_ > 0;
 			if (damped) {
@@ -259,6 +299,9 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 				dampPressureModes<Kernel>(grid_, fields_, std::min<Real>(1, rate), std::min<Real>(edgeRelaxLimit, edgeDampingShare * rate),
 				                          settings_.freeSurfaceThreshold, *w, pressureModes_, workspace_);
 			}
+			// semi-implicit: the points carry the interpolated solution, which holds the faces and the
+			// free surface at their nodes (theory.md §8.5); explicit: the points are reset (eqs. 2.1, 2.3)
+			if (semiImplicit) continue;
 			if (settings_.freeSurfaceThreshold > 0)
 				applyFreeSurface(grid_, fields_, settings_.freeSurfaceThreshold, settings_.freeSurfaceHoldsSuction, *w, damped ? &pressureModes_.kind : nullptr);
 			applyDrainedFaces(grid_, domain_.boundaries, settings_.gravity, water_.density, *w);

@@ -1,8 +1,9 @@
-// Explicit two-phase (solid + pore water) GIMP MPM: the time step as a list of named stages
-// (doc/theory.md §4), time-step limits and sub-stepping. No YADE here: the binding hands over
+// Two-phase (solid + pore water) GIMP MPM, semi-implicit (pressure projection, doc/theory.md §8)
+// or explicit (§4): the time step as a list of named stages, time-step limits and sub-stepping. No YADE here: the binding hands over
 // pointers to the point sets it owns and the validated parameters.
 #pragma once
 
+#include "PressureProjection.hpp"
 #include "Stages.hpp"
 
 #include <array>
@@ -12,15 +13,17 @@
 namespace mpm {
 
 struct SolverSettings {
+	TimeScheme    scheme         = TimeScheme::SemiImplicit;
 	ShapeFunction shapeFunction  = ShapeFunction::UGimp;
 	DragScheme    drag           = DragScheme::SemiImplicit;
 	Real          flipBlend      = 1.0;  // α [-], 0 ≤ α ≤ 1 (1 = FLIP, 0 = PIC)
 	Real          timeStepFactor = 0.5;  // C [-], 0 < C ≤ 1, applied to the critical step
 	Vec3          gravity        = Vec3::Zero(); // b [m s⁻²]
 	bool          cellAveragedVolumetricRate = true; // theory.md eq. 4.17 (pressure and B-bar)
-	bool          pressureModeDamping        = true;  // eq. 4.17b: pressure modes the grid cannot see decay as a one-cell seepage would
+	bool          pressureModeDamping        = false; // eqs. 4.17b–c (explicit scheme only): pressure modes the grid cannot see decay as a one-cell seepage would
+	Real          pressureTolerance          = 1e-3;  // δp [Pa] > 0: the semi-implicit pressure solve stops at the residual of a pressure error δp at a typical node (§8.7)
 	Real          freeSurfaceThreshold       = 0;    // β [-], 0 ≤ β < 1: p = 0 on points filled below β (eq. 2.3); 0: off
-	bool          freeSurfaceHoldsSuction    = false; // eq. 2.3b: the surface keeps suction (p < 0) and releases only p > 0 (a seepage face)
+	bool          freeSurfaceHoldsSuction    = false; // eq. 2.3b (explicit scheme only): the surface keeps suction (p < 0) and releases only p > 0
 	void          validate() const;
 };
 
@@ -43,8 +46,8 @@ struct Domain {
 
 // Time-step limits of the current state (theory.md §5, eqs. 5.1–5.2), before the safety factor.
 struct TimeStepLimits {
-	Real wave;     // h / fastest wave (+ fastest point) [s]
-	Real drag;     // 2/λ of the explicit drag; infinity with semi-implicit drag [s]
+	Real wave;     // h / (fastest wave + fastest point) [s]; semi-implicit: the skeleton wave (eq. 8.10)
+	Real drag;     // 2/λ of the explicit drag; infinity with semi-implicit drag or scheme [s]
 	Real critical; // min of the above [s]
 };
 
@@ -53,6 +56,9 @@ enum class Stage {
 	MapSolidToGrid,
 	MapWaterToGrid,
 	IntegrateNodalMomentum,
+	AssemblePressure,
+	SolvePressure,
+	CorrectVelocities,
 	UpdatePointKinematics,
 	RemapVelocities,
 	UpdateSolidStress,
@@ -88,6 +94,8 @@ public:
 	void updateDrainedValues(const BoundaryConditions& boundaries);
 	const std::array<double, static_cast<int>(Stage::Count)>& stageSeconds() const { return stageSeconds_; }
 	const GridGeometry&                                 grid() const { return grid_; }
+	// The last semi-implicit pressure solve (zeros before the first one or with the explicit scheme).
+	const PressureSolveReport&                          lastPressureSolve() const { return lastPressureSolve_; }
 	const GridFields&                                   fields() const { return fields_; }
 	const SolverSettings&                               settings() const { return settings_; }
 
@@ -120,6 +128,9 @@ private:
 	std::vector<char>             removeFlags_;
 	std::vector<char>             suctionHolding_; // nodes of the suction-holding free surface (eq. 2.3b)
 	PressureModeScratch           pressureModes_; // scratch of eqs. 4.17b–c
+	PressureSystem                pressureSystem_; // eq. 8.7 and its scratch
+	PressureSolveReport           lastPressureSolve_ {};
+	std::vector<std::array<bool, 3>> heldSolid_; // per constrained node: solid components held this step
 	Real                          pressureDiffusivity_ = 0; // c_v [m² s⁻¹] of eq. 4.17b
 	std::array<double, static_cast<int>(Stage::Count)> stageSeconds_ {};
 };

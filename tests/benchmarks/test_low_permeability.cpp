@@ -33,6 +33,8 @@ struct Column {
 		SolverSettings s;
 		s.gravity = Vec3(0, 0, -g);
 		s.drag    = drag;
+		s.scheme  = TimeScheme::Explicit; // the drag limit is the explicit scheme's
+		s.pressureModeDamping = true;
 		solver    = std::make_unique<TwoPhaseSolver>(d, s);
 		solver->setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
 	}

@@ -16,7 +16,7 @@ struct State {
 	WaterPointSet fluid;
 };
 
-State run(int threads)
+State run(int threads, TimeScheme scheme)
 {
 	omp_set_num_threads(threads);
 	SoilParameters  soil;
@@ -32,6 +32,10 @@ State run(int threads)
 	const Domain d = fixtures::columnDomain(Vec3::Constant(side), h);
 	SolverSettings settings;
 	settings.gravity = Vec3(0, 0, -9.81);
+	settings.scheme  = scheme;
+	// the pressure solve stops at this accuracy, and the order of a sum changes which iterate it
+	// stops at: far below the 1e-9 relative bound below
+	settings.pressureTolerance = 1e-7; // [Pa], 1e-10 of the largest pressure
 	TwoPhaseSolver solver(d, settings);
 	solver.setPoints({ SolidSet { &s.solid, soil } }, { &s.fluid }, water);
 	const double dt = 0.5 * solver.timeStepLimits().critical;
@@ -39,10 +43,12 @@ State run(int threads)
 	return s;
 }
 
-TEST(Threads, ResultsIndependentOfThreadCountToRoundOff)
+class Threads : public ::testing::TestWithParam<TimeScheme> {};
+
+TEST_P(Threads, ResultsIndependentOfThreadCountToRoundOff)
 {
 	const int original = omp_get_max_threads();
-	const State one = run(1), two = run(2);
+	const State one = run(1, GetParam()), two = run(2, GetParam());
 	omp_set_num_threads(original);
 	double dx = 0, dv = 0, dp = 0, ds = 0, vScale = 0, pScale = 0, sScale = 0;
 	for (std::size_t p = 0; p < one.solid.size(); ++p) {
@@ -55,11 +61,20 @@ TEST(Threads, ResultsIndependentOfThreadCountToRoundOff)
 		sScale = std::max(sScale, one.solid.effectiveStress[p].norm());
 	}
 	EXPECT_GT(pScale, 0); // something happened
-	EXPECT_LT(dx, 1e-13);
-	EXPECT_LT(dv, 1e-9 * vScale);
-	EXPECT_LT(dp, 1e-9 * pScale);
-	EXPECT_LT(ds, 1e-9 * sScale);
+	// explicit: only the order of the scatter sums differs, so round-off; semi-implicit: the pressure
+	// solve stops at its tolerance (1e-7 Pa ≈ 1e-10 of the largest pressure here) from whichever
+	// iterate the summation order leads to, so the states agree to that tolerance amplified by the
+	// conditioning of the solve (measured: |Δp| 9e-9, |Δv_w| 8e-7, |Δσ′| 1e-7 of their maxima)
+	const bool   explicitScheme = GetParam() == TimeScheme::Explicit;
+	const double bound          = explicitScheme ? 1e-9 : 1e-7;
+	EXPECT_LT(dx, explicitScheme ? 1e-13 : 1e-12);
+	EXPECT_LT(dv, (explicitScheme ? 1e-9 : 1e-5) * vScale);
+	EXPECT_LT(dp, bound * pScale);
+	EXPECT_LT(ds, (explicitScheme ? 1e-9 : 1e-6) * sScale);
 	std::printf("1 vs 2 threads: |Δx| %.2e m, |Δv_w| %.2e of max, |Δp| %.2e of max, |Δσ′| %.2e of max\n", dx, dv / vScale, dp / pScale, ds / sScale);
 }
+
+INSTANTIATE_TEST_SUITE_P(Schemes, Threads, ::testing::Values(TimeScheme::SemiImplicit, TimeScheme::Explicit),
+                         [](const auto& info) { return info.param == TimeScheme::SemiImplicit ? "semiImplicit" : "explicit"; });
 
 } // namespace

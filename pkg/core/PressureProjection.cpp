@@ -1,0 +1,395 @@
+#include "PressureProjection.hpp"
+
+#include "Errors.hpp"
+#include "Stencil.hpp"
+
+#include <Eigen/IterativeLinearSolvers>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace mpm {
+
+namespace {
+	using namespace detail;
+	constexpr Real notDrained = std::numeric_limits<Real>::quiet_NaN();
+
+	// Grid indices (i, j, k) of node I.
+	inline std::array<int, 3> nodeIndices(const GridGeometry& g, std::size_t I)
+	{
+		const std::size_t nx = g.nodes[0], ny = g.nodes[1];
+		return { static_cast<int>(I % nx), static_cast<int>((I / nx) % ny), static_cast<int>(I / (nx * ny)) };
+	}
+
+	// Stencil slot of the offset (a, b, c) ∈ [−2, 2]³ between two nodes sharing a point.
+	inline int offsetSlot(int a, int b, int c) { return (a + 2) + 5 * ((b + 2) + 5 * (c + 2)); }
+} // namespace
+
+namespace stages {
+
+	template <class Kernel>
+	void classifyPressureNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
+	                           const Vec3& gravity, Real waterDensity, Real freeSurfaceThreshold, PressureSystem& system)
+	{
+		const std::size_t nodes = grid.nodeCount();
+		std::vector<int>& row   = system.row;
+		row.assign(nodes, -1);
+		// every node a stencil reaches with a weight or a gradient (the marks race benignly: all write 0)
+		for (const WaterPointSet* set : sets) {
+			const WaterPointSet& P     = *set;
+			const std::size_t    count = P.size();
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+			for (std::size_t p = 0; p < count; ++p) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3&) {
+#pragma omp atomic write
+					row[I] = 0;
+				});
+			}
+		}
+		system.node.clear();
+		for (std::size_t I = 0; I < nodes; ++I)
+			if (row[I] == 0) {
+				row[I] = static_cast<int>(system.node.size());
+				system.node.push_back(I);
+			}
+		const std::size_t active = system.node.size();
+		system.fixed.assign(active, 0);
+		system.fixedValue.assign(active, 0);
+		for (std::size_t r = 0; r < active; ++r) {
+			const std::size_t        I   = system.node[r];
+			const std::array<int, 3> idx = nodeIndices(grid, I);
+			// wall planes and the padding beyond them: a drained face prescribes p̄(t^{n+1}), a free
+			// water face p = 0 (its natural condition, which the compact operator L does not carry)
+			bool open = false, drained = false;
+			Real value = 0;
+			for (int axis = 0; axis < 3; ++axis) {
+				if (grid.periodic[axis]) continue;
+				for (int side = 0; side < 2; ++side) {
+					const bool onOrBeyond = side == 0 ? idx[axis] <= grid.wallNode[axis] : idx[axis] >= grid.upperWallNode[axis];
+					if (!onOrBeyond) continue;
+					const WallConditions& wall = bcs.walls[2 * axis + side];
+					if (wall.water == WaterWall::Drained) {
+						drained = true;
+						value   = wall.drainedPressureAt(grid.nodePosition(idx[0], idx[1], idx[2]), gravity, waterDensity);
+					} else if (wall.water == WaterWall::Free) open = true;
+				}
+			}
+			if (drained) {
+				system.fixed[r]      = 1;
+				system.fixedValue[r] = value;
+			} else if (open) {
+				system.fixed[r] = 1;
+			} else if (freeSurfaceThreshold > 0) {
+				const Real full = grid.inDomainSupportVolume(idx[0], idx[1], idx[2]);
+				if (full > 0 && fields.water[I].volume < freeSurfaceThreshold * full) system.fixed[r] = 1; // eq. 2.3 at the node
+			}
+		}
+	}
+
+	template <class Kernel>
+	void assemblePressureSystem(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const WaterParameters& water,
+	                            const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
+	                            Real waterMassTolerance, PressureSystem& system)
+	{
+		constexpr int S = Kernel::stencil;
+		const Real    rhoWater = water.density;
+		// eq. 8.5 per node and axis, with the phases the walls hold there taken out of the 2×2 system
+		// (the corrector's rules): L then sees the same walls as the exact projection BᵀM⁻¹B
+		const std::size_t nodes = grid.nodeCount();
+		system.mobility.resize(nodes);
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
+		for (std::size_t I = 0; I < nodes; ++I) {
+			const SolidNode& sn = fields.solid[I];
+			const bool       hasS = sn.mass > solidMassTolerance && sn.solidVolume > 0 && sn.volume > 0;
+			system.mobility[I]    = Vec3::Constant(hasS ? pressureMobility(fields.porosity[I], sn.mass / sn.solidVolume, rhoWater, sn.drag * dt / sn.volume)
+			                                            : 1 / rhoWater);
+		}
+		for (std::size_t c = 0; c < constrained.node.size(); ++c) {
+			const std::size_t     I  = constrained.node[c];
+			const SolidNode&      sn = fields.solid[I];
+			const bool hasS = sn.mass > solidMassTolerance && sn.solidVolume > 0 && sn.volume > 0, hasW = fields.water[I].mass > waterMassTolerance;
+			const Real n = hasS ? fields.porosity[I] : 1;
+			for (int d = 0; d < 3; ++d) {
+				const bool solidHeld = hasS && heldSolid[c][d], waterHeld = constrained.constraint[c].water[d];
+				if (solidHeld && waterHeld) system.mobility[I][d] = 0;
+				else if (solidHeld) system.mobility[I][d] = hasW ? n * n / (n * rhoWater + sn.drag * dt / sn.volume) : 0; // water dragged past held grains
+				else if (waterHeld) system.mobility[I][d] = hasS ? sn.solidVolume / sn.mass : 0;                          // 1/ρs: the grains take the whole force
+			}
+		}
+		system.rows.assign(system.node.size() * PressureSystem::rowStride, 0);
+		system.porosityGradient.resize(sets.size());
+		const Real invKw = 1 / water.bulkModulus; // 0 for incompressible water (Kw = ∞)
+		for (std::size_t s = 0; s < sets.size(); ++s) {
+			const WaterPointSet& P     = *sets[s];
+			std::vector<Vec3>&   gradN = system.porosityGradient[s];
+			gradN.resize(P.size());
+			scatter(system.rows, system.rowBuffers, P.size(), [&](std::size_t p, Real* rows) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				int node[3][S];
+				stencilNodes(grid, w, node);
+				// the solid fields at the water point (eqs. 4.5, 8.5) and the predicted velocities
+				Real n = 0, divS = 0, divW = 0;
+				Vec3 gradn = Vec3::Zero(), vs = Vec3::Zero(), vw = Vec3::Zero(), lambda = Vec3::Zero();
+				Real N[S][S][S];
+				Vec3 dN[S][S][S];
+				for (int c = 0; c < S; ++c)
+					for (int b = 0; b < S; ++b)
+						for (int a = 0; a < S; ++a) {
+							N[c][b][a]  = w[0].value[a] * w[1].value[b] * w[2].value[c];
+							dN[c][b][a] = Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
+							                   w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
+							const std::size_t I  = grid.index(node[0][a], node[1][b], node[2][c]);
+							const Real        Ni = N[c][b][a];
+							n += Ni * fields.porosity[I];
+							gradn += fields.porosity[I] * dN[c][b][a];
+							lambda += Ni * system.mobility[I];
+							vs += Ni * fields.solidVelocityNew[I];
+							vw += Ni * fields.waterVelocityNew[I];
+							divS += fields.solidVelocityNew[I].dot(dN[c][b][a]);
+							divW += fields.waterVelocityNew[I].dot(dN[c][b][a]);
+						}
+				n        = std::clamp<Real>(n, 1e-5, 1);
+				gradN[p] = gradn;
+				const Real V = P.volume[p];
+				// eq. 8.2: the divergence of the mixture's volume flux, with the (vw − vs)·∇n term of E2′
+				const Real divergence = (1 - n) * divS + n * divW + (vw - vs).dot(gradn);
+				const Real storage    = V * n * invKw / dt; // C/Δt (eq. 8.3), consistent: Σ V S_J S_K n/(Kw Δt)
+				const Vec3 conductance = dt * V * lambda;    // Δt L (eq. 8.6), per axis
+				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n
+				for (int c = 0; c < S; ++c)
+					for (int b = 0; b < S; ++b)
+						for (int a = 0; a < S; ++a) {
+							const Real Nj = N[c][b][a];
+							if (Nj == 0 && dN[c][b][a].isZero()) continue;
+							Real* r = rows + static_cast<std::size_t>(system.row[grid.index(node[0][a], node[1][b], node[2][c])]) * PressureSystem::rowStride;
+							r[PressureSystem::rhsSlot] += Nj * (stored - V * divergence);
+							for (int cc = 0; cc < S; ++cc)
+								for (int bb = 0; bb < S; ++bb)
+									for (int aa = 0; aa < S; ++aa)
+										r[offsetSlot(aa - a, bb - b, cc - c)] += storage * Nj * N[cc][bb][aa] + dN[c][b][a].dot(conductance.cwiseProduct(dN[cc][bb][aa]));
+						}
+			});
+		}
+	}
+
+	void buildPressureMatrix(const GridGeometry& grid, PressureSystem& system)
+	{
+		const std::size_t active = system.node.size();
+		// A node that points reach only by the round-off tail of their weights (a point whose domain
+		// ends exactly at a node plane) carries no equation worth the name: its coupling is ~1e-16 of
+		// the others and would ruin the conditioning. Such a node, and one no point's gradient reaches
+		// that stores nothing (incompressible water), is held at p = 0.
+		Real largestDiagonal = 0;
+		for (std::size_t r = 0; r < active; ++r) largestDiagonal = std::max(largestDiagonal, system.rows[r * PressureSystem::rowStride + offsetSlot(0, 0, 0)]);
+		const Real negligible = std::numeric_limits<Real>::epsilon() * largestDiagonal;
+		for (std::size_t r = 0; r < active; ++r)
+			if (!system.fixed[r] && !(system.rows[r * PressureSystem::rowStride + offsetSlot(0, 0, 0)] > negligible)) system.fixed[r] = 1, system.fixedValue[r] = 0;
+		system.unknown.assign(active, -1);
+		int n = 0;
+		for (std::size_t r = 0; r < active; ++r)
+			if (!system.fixed[r]) system.unknown[r] = n++;
+		system.rhs.resize(n);
+		// CSR of the free rows: the columns of a row sorted and merged (on a periodic axis of 3 cells
+		// two offsets reach one node), the prescribed columns moved to the right-hand side
+		struct Entry {
+			int  column;
+			Real value;
+		};
+		using Entries = std::array<Entry, PressureSystem::offsets>;
+		auto collect = [&](std::size_t r, Entries& entries, Real& rhs) {
+			const Real*              k   = system.rows.data() + r * PressureSystem::rowStride;
+			const std::array<int, 3> idx = nodeIndices(grid, system.node[r]);
+			int                      used = 0;
+			rhs                          = k[PressureSystem::rhsSlot];
+			for (int o = 0; o < PressureSystem::offsets; ++o) {
+				if (k[o] == 0) continue; // a non-zero coefficient joins two nodes of one stencil: both on the grid
+				const int         a = o % 5 - 2, b = (o / 5) % 5 - 2, c = o / 25 - 2;
+				const std::size_t J = grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c));
+				const int         col = system.row[J];
+				if (system.fixed[col]) rhs -= k[o] * system.fixedValue[col];
+				else entries[used++] = Entry { system.unknown[col], k[o] };
+			}
+			std::sort(entries.begin(), entries.begin() + used, [](const Entry& x, const Entry& y) { return x.column < y.column; });
+			int merged = 0;
+			for (int e = 0; e < used; ++e) {
+				if (merged > 0 && entries[merged - 1].column == entries[e].column) entries[merged - 1].value += entries[e].value;
+				else entries[merged++] = entries[e];
+			}
+			return merged;
+		};
+		std::vector<int> start(n + 1, 0);
+#pragma omp parallel for schedule(static) if(active > parallelThreshold)
+		for (std::size_t r = 0; r < active; ++r) {
+			if (system.fixed[r]) continue;
+			Entries entries;
+			Real    rhs;
+			start[system.unknown[r] + 1] = collect(r, entries, rhs);
+		}
+		for (int i = 0; i < n; ++i) start[i + 1] += start[i];
+		Eigen::SparseMatrix<Real, Eigen::RowMajor>& A = system.matrix;
+		A.resize(n, n);
+		A.resizeNonZeros(start[n]);
+		std::copy(start.begin(), start.end(), A.outerIndexPtr());
+		Real diagonalSum = 0;
+#pragma omp parallel for schedule(static) reduction(+ : diagonalSum) if(active > parallelThreshold)
+		for (std::size_t r = 0; r < active; ++r) {
+			if (system.fixed[r]) continue;
+			Entries   entries;
+			Real      rhs;
+			const int count = collect(r, entries, rhs), u = system.unknown[r];
+			system.rhs[u]   = rhs;
+			for (int e = 0; e < count; ++e) {
+				A.innerIndexPtr()[start[u] + e] = entries[e].column;
+				A.valuePtr()[start[u] + e]      = entries[e].value;
+				if (entries[e].column == u) diagonalSum += entries[e].value;
+			}
+		}
+		system.meanDiagonal = n > 0 ? diagonalSum / n : 0;
+	}
+
+	PressureSolveReport solvePressure(PressureSystem& system, Real tolerance)
+	{
+		PressureSolveReport report;
+		const std::size_t   active = system.node.size();
+		const long          n      = system.matrix.rows();
+		report.unknowns            = static_cast<std::size_t>(n);
+		report.fixed               = active - report.unknowns;
+		system.nodalPressure.assign(system.row.size(), 0);
+		for (std::size_t r = 0; r < active; ++r)
+			if (system.fixed[r]) system.nodalPressure[system.node[r]] = system.fixedValue[r];
+		if (n == 0) return report;
+		const Real typical = system.meanDiagonal;
+		// warm start: the last step's pressure at the same grid node
+		system.solution.setZero(n);
+		for (std::size_t e = 0; e < system.previousNode.size(); ++e) {
+			const int r = system.row[system.previousNode[e]];
+			if (r >= 0 && !system.fixed[r]) system.solution[system.unknown[r]] = system.previousSolution[e];
+		}
+		const Real rhsNorm = system.rhs.norm();
+		if (rhsNorm > 0) {
+			Eigen::ConjugateGradient<Eigen::SparseMatrix<Real, Eigen::RowMajor>, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<Real>> cg;
+			cg.setTolerance(std::min<Real>(0.1, tolerance * typical / rhsNorm));
+			cg.setMaxIterations(std::max<long>(1000, 2 * n));
+			cg.compute(system.matrix);
+			system.solution  = cg.solveWithGuess(system.rhs, system.solution);
+			report.iterations = cg.iterations();
+			report.residual   = cg.error() * rhsNorm / typical;
+			if (cg.info() != Eigen::Success || !system.solution.allFinite()) {
+				std::ostringstream msg;
+				msg << "the pore-pressure solve did not converge: " << report.iterations << " conjugate-gradient iterations on " << n
+				    << " pressure nodes left a residual of " << report.residual << " Pa against pressureTolerance = " << tolerance
+				    << " Pa (check the time step, the permeability and that every water region touches a drained face or has compressible water)";
+				throw InstabilityError(msg.str());
+			}
+		} else {
+			system.solution.setZero(n);
+		}
+		system.previousNode.clear();
+		system.previousSolution.resize(n);
+		for (std::size_t r = 0; r < active; ++r) {
+			if (system.fixed[r]) continue;
+			const int u = system.unknown[r];
+			system.nodalPressure[system.node[r]] = system.solution[u];
+			system.previousSolution[system.previousNode.size()] = system.solution[u];
+			system.previousNode.push_back(system.node[r]);
+		}
+		return report;
+	}
+
+	template <class Kernel>
+	void correctVelocities(const GridGeometry& grid, GridFields& fields, std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
+	                       const Vec3& gravity, Real waterDensity, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid,
+	                       Real dt, Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system)
+	{
+		const std::vector<Real>& pressure = system.nodalPressure;
+		system.forces.assign(grid.nodeCount(), zeroOf(PressureForceNode {}));
+		for (std::size_t s = 0; s < sets.size(); ++s) {
+			WaterPointSet&           P     = *sets[s];
+			const std::vector<Vec3>& gradN = system.porosityGradient[s];
+			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				Real q = 0;
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) { q += N * pressure[I]; });
+				P.porePressure[p] = q; // S4a: p^{n+1} at the point, with the weights of t^n
+				const Real n = P.porosity[p], Vq = P.volume[p] * q;
+				const Vec3 gn = gradN[p];
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					nodes[I].water += Vq * (n * dN + N * gn);       // eq. 8.1: ∇(n S_I)
+					nodes[I].solid += Vq * ((1 - n) * dN - N * gn); // ∇((1 − n) S_I)
+				});
+			});
+		}
+		// the boundary terms of drained faces with p̄ ≠ 0 (eq. 2.2): −∮ N n p̄ n̂ on the water, the
+		// rest of −∮ N p̄ n̂ on the solid. They belong with the pressure forces: in the predictor they
+		// would meet no pressure gradient and throw the face nodes' water far off before the solve.
+		forEachDrainedFaceTraction(grid, bcs, gravity, waterDensity, waterMassTolerance, fields, [&](std::size_t I, const Vec3& traction) {
+			system.forces[I].water += fields.porosity[I] * traction;
+			system.forces[I].solid += (1 - fields.porosity[I]) * traction;
+		});
+		// eq. 8.8: the nodal 2×2 drag system for the velocity increments
+		const std::size_t nodes = grid.nodeCount();
+		auto increments = [&](std::size_t i, Vec3& ds, Vec3& dw) {
+			const SolidNode&         s = fields.solid[i];
+			const WaterNode&         wn = fields.water[i];
+			const PressureForceNode& g = system.forces[i];
+			const bool hasS = s.mass > solidMassTolerance, hasW = wn.mass > waterMassTolerance;
+			ds = dw = Vec3::Zero();
+			if (hasS && hasW) {
+				const Real ms = s.mass, mw = wn.mass, QDt = s.drag * dt, D = ms * mw + QDt * (ms + mw);
+				ds = (dt / D) * ((mw + QDt) * g.solid + QDt * g.water);
+				dw = (dt / D) * (QDt * g.solid + (ms + QDt) * g.water);
+			} else if (hasW) {
+				dw = (dt / wn.mass) * g.water;
+			} else if (hasS) {
+				ds = (dt / s.mass) * (g.solid + g.water); // the whole pressure force on the mixture
+			}
+		};
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
+		for (std::size_t i = 0; i < nodes; ++i) {
+			Vec3 ds, dw;
+			increments(i, ds, dw);
+			fields.solidVelocityNew[i] += ds;
+			fields.waterVelocityNew[i] += dw;
+		}
+		// held components (theory.md §2): the same rules as in the predictor, for the velocity increments
+		for (std::size_t c = 0; c < constrained.node.size(); ++c) {
+			const std::size_t        i  = constrained.node[c];
+			const NodeConstraint&    nc = constrained.constraint[c];
+			const SolidNode&         s  = fields.solid[i];
+			const WaterNode&         wn = fields.water[i];
+			const PressureForceNode& g  = system.forces[i];
+			const bool hasS = s.mass > solidMassTolerance, hasW = wn.mass > waterMassTolerance;
+			Vec3 ds, dw;
+			increments(i, ds, dw);
+			for (int d = 0; d < 3; ++d) {
+				const bool solidHeld = heldSolid[c][d], waterHeld = nc.water[d];
+				if (!solidHeld && !waterHeld) continue;
+				Real dsHeld = 0, dwHeld = 0;
+				if (solidHeld && !waterHeld && hasW) dwHeld = dt * g.water[d] / (wn.mass + (hasS ? s.drag * dt : 0)); // water dragged by the held solid
+				if (waterHeld && !solidHeld && hasS) dsHeld = dt * (g.solid[d] + g.water[d]) / s.mass;               // mixture momentum, water held
+				fields.solidVelocityNew[i][d] += dsHeld - ds[d];
+				fields.waterVelocityNew[i][d] += dwHeld - dw[d];
+			}
+		}
+	}
+
+#define MPM_INSTANTIATE_PROJECTION(K)                                                                                                      \
+	template void classifyPressureNodes<K>(const GridGeometry&, const GridFields&, const std::vector<WaterPointSet*>&, const BoundaryConditions&, \
+	                                       const Vec3&, Real, Real, PressureSystem&);                                                         \
+	template void assemblePressureSystem<K>(const GridGeometry&, const GridFields&, const std::vector<WaterPointSet*>&, const WaterParameters&,  \
+	                                        const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real, PressureSystem&);  \
+	template void correctVelocities<K>(const GridGeometry&, GridFields&, std::vector<WaterPointSet*>&, const BoundaryConditions&,            \
+	                                   const Vec3&, Real, const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,  \
+	                                   PressureSystem&);
+
+	MPM_INSTANTIATE_PROJECTION(LinearKernel)
+	MPM_INSTANTIATE_PROJECTION(GimpKernel)
+
+} // namespace stages
+} // namespace mpm

@@ -1,0 +1,122 @@
+// The pressure projection of the semi-implicit double-point step (doc/theory.md §8): the nodal
+// pore pressure p^{n+1} solved implicitly each step from the mixture volume balance (a Chorin
+// projection on the total pressure), with water inertia and Darcy drag kept in both phases'
+// momentum. The stages are free functions like
+// those of Stages.hpp; the linear system lives in PressureSystem so that the solve can be handed
+// to another solver without touching the stages.
+#pragma once
+
+#include "Stages.hpp"
+
+#include <Eigen/SparseCore>
+
+#include <array>
+#include <vector>
+
+namespace mpm {
+
+// How the step advances the pore pressure (theory.md §4 and §8).
+enum class TimeScheme {
+	SemiImplicit, // pressure implicit (projection, eqs. 8.7–8.8): Δt limited by the skeleton wave and the points' speed only
+	Explicit,     // pressure explicit from the volume balance (eq. 4.16): Δt limited by the undrained wave (eq. 5.1)
+};
+
+// Nodal sums of the pore-pressure forces (theory.md eq. 8.1): g^s, g^w.
+struct PressureForceNode {
+	Vec3 solid; // g^s_I = Σ V p ∇((1 − n) S_I) [N]
+	Vec3 water; // g^w_I = Σ V p ∇(n S_I) [N]
+};
+inline PressureForceNode& operator+=(PressureForceNode& a, const PressureForceNode& b)
+{
+	a.solid += b.solid;
+	a.water += b.water;
+	return a;
+}
+inline PressureForceNode zeroOf(const PressureForceNode&) { return PressureForceNode { Vec3::Zero(), Vec3::Zero() }; }
+
+// What one pressure solve did (theory.md §8.7).
+struct PressureSolveReport {
+	std::size_t unknowns   = 0; // free pressure nodes [-]
+	std::size_t fixed      = 0; // nodes with a prescribed pressure (drained and free faces, free surface) [-]
+	long        iterations = 0; // conjugate-gradient iterations [-]
+	Real        residual   = 0; // ‖r‖₂ / mean K_JJ at the end: a pressure [Pa]
+};
+
+// The grid-node system of eq. 8.7 and its scratch, reused from step to step.
+struct PressureSystem {
+	// One row of K in stencil form: offsets (−2..2)³ between two nodes that share a point, then b_J.
+	static constexpr int offsets   = 125;
+	static constexpr int rowStride = offsets + 1;
+	static constexpr int rhsSlot   = offsets;
+
+	std::vector<int>         row;            // per grid node: its pressure node, −1 where no water point reaches
+	std::vector<std::size_t> node;           // per pressure node: the grid node
+	std::vector<char>        fixed;          // per pressure node: the pressure is prescribed
+	std::vector<Real>        fixedValue;     // per pressure node: prescribed p^{n+1} where fixed [Pa]
+	std::vector<int>         unknown;        // per pressure node: its index among the unknowns, −1 where fixed
+	std::vector<Real>        rows;           // per pressure node: rowStride coefficients (K [m³ s⁻¹ Pa⁻¹], then b [m³ s⁻¹])
+	std::vector<std::vector<Real>> rowBuffers; // per extra thread
+	std::vector<Real>        nodalPressure;   // per grid node: p^{n+1}, 0 off the pressure nodes [Pa]
+	std::vector<Vec3>        mobility;        // per grid node and axis: λ of eq. 8.5 with the walls' holds [m³ kg⁻¹]
+	std::vector<std::vector<Vec3>> porosityGradient; // per water set and point: ∇n at t^n [m⁻¹]
+	std::vector<PressureForceNode>              forces;
+	std::vector<std::vector<PressureForceNode>> forceBuffers;
+	Eigen::SparseMatrix<Real, Eigen::RowMajor> matrix;
+	Eigen::Matrix<Real, Eigen::Dynamic, 1>     rhs, solution, previousSolution;
+	std::vector<std::size_t>                   previousNode; // grid node of each entry of previousSolution (warm start)
+	Real                                       meanDiagonal = 0; // mean K_JJ of the free rows [m³ s⁻¹ Pa⁻¹]
+};
+
+namespace stages {
+
+	// Pressure nodes and their conditions (theory.md §8.5): every grid node a water point's stencil
+	// reaches; prescribed pressures on the wall planes (and beyond) of drained faces, p̄(t^{n+1}),
+	// and of free water faces and free-surface nodes (filling V^w_I/V^full_I below
+	// `freeSurfaceThreshold`, 0: none), p = 0.
+	template <class Kernel>
+	void classifyPressureNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
+	                           const Vec3& gravity, Real waterDensity, Real freeSurfaceThreshold, PressureSystem& system);
+
+	// K = C/Δt + Δt L and b = C p^n/Δt − Bᵀ v* of eq. 8.7 at the pressure nodes, by one pass over
+	// the water points (eqs. 8.2, 8.3, 8.5, 8.6), with the predicted nodal velocities v* of both
+	// phases and the points' pressures p^n. The mobility λ of eq. 8.5 is taken per node and axis,
+	// with the phases held by walls (`heldSolid`, the water constraints) out of its 2×2 system, and
+	// interpolated to the points.
+	template <class Kernel>
+	void assemblePressureSystem(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const WaterParameters& water,
+	                            const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
+	                            Real waterMassTolerance, PressureSystem& system);
+
+	// The free rows of eq. 8.7 as a sparse (CSR) matrix and right-hand side, the prescribed
+	// pressures moved to the right-hand side: what a linear solver needs, nothing of the grid.
+	void buildPressureMatrix(const GridGeometry& grid, PressureSystem& system);
+
+	// Solve eq. 8.7 for the free nodal pressures with Eigen's conjugate gradient,
+	// Jacobi-preconditioned, warm-started from the last step's pressures; stops when
+	// ‖r‖₂ ≤ tolerance × mean K_JJ: the residual of a pressure error `tolerance` [Pa] at a typical node,
+	// the same meaning at every permeability and load (theory.md §8.7). Throws InstabilityError when
+	// it does not converge.
+	PressureSolveReport solvePressure(PressureSystem& system, Real tolerance);
+
+	// Corrector (theory.md eq. 8.8): the point pressures p_wp = Σ S p_J (weights at t^n), their
+	// forces g^s, g^w with the drained faces' boundary terms (eq. 2.2), and the nodal velocity
+	// increments of the 2×2 drag system, with the wall
+	// holds of the predictor (`heldSolid` per constrained node).
+	template <class Kernel>
+	void correctVelocities(const GridGeometry& grid, GridFields& fields, std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
+	                       const Vec3& gravity, Real waterDensity, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid,
+	                       Real dt, Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system);
+
+	// Mobility λ per unit volume of eq. 8.5 [m³ kg⁻¹]: [1−n, n] M⁻¹ [1−n, n]ᵀ of the nodal 2×2
+	// system per unit volume, with partial densities (1−n)ρs, nρw and drag Q̂Δt (Q̂ = n²μw/κ).
+	// Free water (n = 1): 1/ρw.
+	inline Real pressureMobility(Real n, Real grainDensity, Real waterDensity, Real dragTimesDt)
+	{
+		if (n >= 1) return 1 / waterDensity;
+		const Real numerator   = (1 - n) * (1 - n) * n * waterDensity + n * n * (1 - n) * grainDensity + dragTimesDt;
+		const Real denominator = n * (1 - n) * grainDensity * waterDensity + dragTimesDt * ((1 - n) * grainDensity + n * waterDensity);
+		return numerator / denominator;
+	}
+
+} // namespace stages
+} // namespace mpm

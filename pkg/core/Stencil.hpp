@@ -1,0 +1,93 @@
+// Loops over a point's stencil nodes and the race-free scatter shared by the stages
+// (doc/theory.md §3–4). Internal to the core: included by the stage sources only.
+#pragma once
+
+#include "Grid.hpp"
+#include "ShapeFunctions.hpp"
+
+#include <omp.h>
+
+#include <cmath>
+#include <vector>
+
+namespace mpm::detail {
+
+	// Shape-function weights of one point along the three axes (theory.md eq. 3.2).
+	template <class Kernel> inline void weightsAt(const GridGeometry& g, const Vec3& x, const Vec3& halfLength, Weights1D (&w)[3])
+	{
+		const Real invH = 1 / g.cellSize;
+		for (int d = 0; d < 3; ++d) Kernel::evaluate((x[d] - g.origin[d]) * invH, std::min<Real>(halfLength[d] * invH, 0.5), invH, w[d]);
+	}
+
+	// Node indices of the stencil per axis, wrapped along periodic axes (theory.md §2.7):
+	// node[d][a] is the a-th stencil node along axis d.
+	template <int S> inline void stencilNodes(const GridGeometry& g, const Weights1D (&w)[3], int (&node)[3][S])
+	{
+		for (int d = 0; d < 3; ++d)
+			for (int a = 0; a < S; ++a) node[d][a] = g.wrap(d, w[d].first + a);
+	}
+
+	// Call f(node, S, ∇S) for every node of the point's stencil (tensor product).
+	template <class Kernel, class F> inline void forEachNode(const GridGeometry& g, const Weights1D (&w)[3], F&& f)
+	{
+		constexpr int S = Kernel::stencil;
+		int           node[3][S];
+		stencilNodes(g, w, node);
+		for (int c = 0; c < S; ++c)
+			for (int b = 0; b < S; ++b) {
+				const Real        vyz  = w[1].value[b] * w[2].value[c];
+				const Real        gyz  = w[1].gradient[b] * w[2].value[c];
+				const Real        vygz = w[1].value[b] * w[2].gradient[c];
+				const std::size_t row  = g.index(0, node[1][b], node[2][c]);
+				for (int a = 0; a < S; ++a) {
+					const Real N = w[0].value[a] * vyz;
+					if (N == 0 && w[0].gradient[a] == 0) continue;
+					f(row + node[0][a], N, Vec3(w[0].gradient[a] * vyz, w[0].value[a] * gyz, w[0].value[a] * vygz));
+				}
+			}
+	}
+
+	// A periodic coordinate brought back into [lower, upper) (theory.md §2.7)
+	inline void wrapPosition(const GridGeometry& g, Vec3& x)
+	{
+		for (int d = 0; d < 3; ++d) {
+			if (!g.periodic[d]) continue;
+			const Real lower = g.origin[d] + g.wallNode[d] * g.cellSize, length = (g.upperWallNode[d] - g.wallNode[d]) * g.cellSize;
+			x[d] -= length * std::floor((x[d] - lower) / length);
+			if (x[d] >= lower + length) x[d] -= length; // round-off of the line above
+		}
+	}
+
+	// Race-free scatter: thread 0 adds into `target`, the others into private copies that are
+	// then summed node by node. Results differ between thread counts only by round-off.
+	inline SolidNode zeroOf(const SolidNode&) { return SolidNode { 0, Vec3::Zero(), Vec3::Zero(), 0, 0, 0 }; }
+	inline WaterNode zeroOf(const WaterNode&) { return WaterNode { 0, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0, 0 }; }
+	inline Vec3      zeroOf(const Vec3&) { return Vec3::Zero(); }
+	inline Real      zeroOf(const Real&) { return 0; }
+	inline PressureNode zeroOf(const PressureNode&) { return PressureNode { 0, 0 }; }
+	inline PressureCell zeroOf(const PressureCell&) { return PressureCell { 0, Vec3::Zero(), Mat3::Zero(), 0, Vec3::Zero() }; }
+	inline MomentumNode zeroOf(const MomentumNode&) { return MomentumNode { Vec3::Zero(), 0 }; }
+
+	template <class Node, class F> void scatter(std::vector<Node>& target, std::vector<std::vector<Node>>& buffers, std::size_t count, F&& perPoint)
+	{
+		const int threads = count <= parallelThreshold ? 1 : omp_get_max_threads();
+		if (threads == 1) {
+			for (std::size_t p = 0; p < count; ++p) perPoint(p, target.data());
+			return;
+		}
+		buffers.resize(threads - 1);
+		for (auto& b : buffers) b.assign(target.size(), zeroOf(Node {}));
+#pragma omp parallel num_threads(threads)
+		{
+			const int tid = omp_get_thread_num();
+			Node*     dst = tid == 0 ? target.data() : buffers[tid - 1].data();
+#pragma omp for schedule(static)
+			for (std::size_t p = 0; p < count; ++p) perPoint(p, dst);
+		}
+		const std::size_t nodes = target.size();
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
+		for (std::size_t i = 0; i < nodes; ++i)
+			for (auto& b : buffers) target[i] += b[i];
+	}
+
+} // namespace mpm::detail
