@@ -31,7 +31,7 @@ namespace stages {
 
 	template <class Kernel>
 	void classifyPressureNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
-	                           const Vec3& gravity, Real waterDensity, Real freeSurfaceThreshold, PressureSystem& system)
+	                           const Vec3& gravity, Real waterDensity, PressureSystem& system)
 	{
 		const std::size_t nodes = grid.nodeCount();
 		std::vector<int>& row   = system.row;
@@ -83,9 +83,9 @@ namespace stages {
 				system.fixedValue[r] = value;
 			} else if (open) {
 				system.fixed[r] = 1;
-			} else if (freeSurfaceThreshold > 0) {
+			} else {
 				const Real full = grid.inDomainSupportVolume(idx[0], idx[1], idx[2]);
-				if (full > 0 && fields.water[I].volume < freeSurfaceThreshold * full) system.fixed[r] = 1; // eq. 2.3 at the node
+				if (full > 0 && fields.water[I].volume < freeSurfaceFilling * full) system.fixed[r] = 1; // eq. 2.3 at the node
 			}
 		}
 	}
@@ -381,7 +381,7 @@ namespace stages {
 
 #define MPM_INSTANTIATE_PROJECTION(K)                                                                                                      \
 	template void classifyPressureNodes<K>(const GridGeometry&, const GridFields&, const std::vector<WaterPointSet*>&, const BoundaryConditions&, \
-	                                       const Vec3&, Real, Real, PressureSystem&);                                                         \
+	                                       const Vec3&, Real, PressureSystem&);                                                         \
 	template void assemblePressureSystem<K>(const GridGeometry&, const GridFields&, const std::vector<WaterPointSet*>&, const WaterParameters&,  \
 	                                        const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real, PressureSystem&);  \
 	template void correctVelocities<K>(const GridGeometry&, GridFields&, std::vector<WaterPointSet*>&, const BoundaryConditions&,            \

@@ -69,13 +69,20 @@ struct PressureSystem {
 
 namespace stages {
 
+	// A node whose water-point volume V^w_I fills less than this share of its in-domain support
+	// V^full_I lies on a free surface (theory.md §8.5): the plane node of a flat surface is half
+	// filled, the next node inwards full, so any value between separates them; 0.75 keeps a margin
+	// of a quarter either way for compression and uneven points. The compact operator L carries no
+	// p = 0 of its own at a free surface (its natural condition is a zero normal gradient), so the
+	// semi-implicit scheme always needs these nodes.
+	constexpr Real freeSurfaceFilling = 0.75;
+
 	// Pressure nodes and their conditions (theory.md §8.5): every grid node a water point's stencil
 	// reaches; prescribed pressures on the wall planes (and beyond) of drained faces, p̄(t^{n+1}),
-	// and of free water faces and free-surface nodes (filling V^w_I/V^full_I below
-	// `freeSurfaceThreshold`, 0: none), p = 0.
+	// and of free water faces and free-surface nodes (filling below freeSurfaceFilling), p = 0.
 	template <class Kernel>
 	void classifyPressureNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
-	                           const Vec3& gravity, Real waterDensity, Real freeSurfaceThreshold, PressureSystem& system);
+	                           const Vec3& gravity, Real waterDensity, PressureSystem& system);
 
 	// K = C/Δt + Δt L and b = C p^n/Δt − Bᵀ v* of eq. 8.7 at the pressure nodes, by one pass over
 	// the water points (eqs. 8.2, 8.3, 8.5, 8.6), with the predicted nodal velocities v* of both

@@ -133,11 +133,14 @@ namespace stages {
 				// eq. 4.5: porosity and its gradient at the water point from the nodal field
 				Real n = 0;
 				Vec3 gradN = Vec3::Zero();
+				bool soil  = false;
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 					n += N * nodalPorosity[I];
 					gradN += nodalPorosity[I] * dN;
+					soil = soil || (N > 0 && nodalPorosity[I] < 1);
 				});
-				n              = std::clamp<Real>(n, 1e-5, 1);
+				// free water is n = 1 exactly (the sum of the weights is 1 only to round-off)
+				n              = soil ? std::clamp<Real>(n, 1e-5, 1) : 1;
 				P.porosity[p]  = n;
 				const Real m = P.mass[p], V = P.volume[p], pressure = pressureForces ? P.porePressure[p] : 0;
 				const Vec3 weight = m * gravity;

@@ -223,7 +223,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	if (semiImplicit) {
 		{
 			StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.1–8.7
-			classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, settings_.freeSurfaceThreshold, pressureSystem_);
+			classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, pressureSystem_);
 			assemblePressureSystem<Kernel>(grid_, fields_, waters_, water_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
 			                               pressureSystem_);
 			buildPressureMatrix(grid_, pressureSystem_);

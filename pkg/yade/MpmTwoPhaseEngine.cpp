@@ -30,6 +30,8 @@ namespace {
 	const std::array<std::pair<const char*, mpm::ShapeFunction>, 3> shapeOptions {
 		{ { "linear", mpm::ShapeFunction::Linear }, { "uGIMP", mpm::ShapeFunction::UGimp }, { "cpGIMP", mpm::ShapeFunction::CpGimp } }
 	};
+	const std::array<std::pair<const char*, mpm::TimeScheme>, 2> schemeOptions { { { "semi-implicit", mpm::TimeScheme::SemiImplicit },
+		                                                                         { "explicit", mpm::TimeScheme::Explicit } } };
 	const std::array<std::pair<const char*, mpm::DragScheme>, 2> dragOptions { { { "semi-implicit", mpm::DragScheme::SemiImplicit },
 		                                                                       { "explicit", mpm::DragScheme::Explicit } } };
 	const std::array<std::pair<const char*, mpm::SolidWall>, 4> solidWallOptions {
@@ -87,6 +89,8 @@ mpm::Domain MpmTwoPhaseEngine::domain() const
 mpm::SolverSettings MpmTwoPhaseEngine::settings() const
 {
 	mpm::SolverSettings s;
+	s.scheme                     = parseOption("scheme", scheme, schemeOptions);
+	s.pressureTolerance          = pressureTolerance;
 	s.shapeFunction              = parseOption("shapeFunction", shapeFunction, shapeOptions);
 	s.drag                       = parseOption("drag", drag, dragOptions);
 	s.flipBlend                  = flipBlend;
@@ -138,6 +142,7 @@ void MpmTwoPhaseEngine::action()
 	solver_->setPoints(std::move(solids), std::move(waters), water, waterNames); // validates every point set
 	subStepsLast     = solver_->advance(dt);
 	criticalTimeStep = solver_->lastTimeStepLimits().critical;
+	pressureSolveIterations = solver_->lastPressureSolve().iterations;
 	solverSteps      = solver_->stepCount();
 	removedWaterMass = removedBefore_ + solver_->removedWaterMass();
 	injectedWaterMass = injectedBefore_ + solver_->injectedWaterMass();
@@ -151,7 +156,7 @@ void MpmTwoPhaseEngine::action()
 
 MpmTwoPhaseEngine::Structure MpmTwoPhaseEngine::structure() const
 {
-	return Structure { gravity,       timeStepFactor, flipBlend,  domainMin,  domainMax,  cellSize,               shapeFunction, drag,
+	return Structure { scheme, pressureTolerance, gravity,       timeStepFactor, flipBlend,  domainMin,  domainMax,  cellSize,               shapeFunction, drag,
 		           cellAveraging, pressureModeDamping, freeSurfaceThreshold, freeSurfaceHoldsSuction, solidWalls, wallFriction, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow, periodic };
 }
 
@@ -186,14 +191,18 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		vector3Attr("domainMax", &E::domainMax, "Upper corner of the domain box; each extent a whole number of cells [m]"),
 		realAttr("cellSize", &E::cellSize, "Cell size h of the background grid (cubic cells) [m]"),
 		stringAttr("shapeFunction", &E::shapeFunction, "Shape functions [-]: 'linear', 'uGIMP' (constant point domains) or 'cpGIMP' (domains follow the stretch)"),
-		stringAttr("drag", &E::drag, "Drag integration [-]: 'semi-implicit' (no drag time-step limit) or 'explicit'"),
+		stringAttr("scheme", &E::scheme,
+		           "Time integration of the pore pressure [-], default 'semi-implicit': the nodal pore pressure is solved implicitly each step (a projection, theory.md §8), so the step is limited by the skeleton's wave and the points' speed only, not by the water's bulk modulus or the permeability; real water (bulkModulus 2.2e9) and incompressible water (inf) cost no more. 'explicit': the pressure follows the water's volume rate point by point (theory.md §4), the step follows the undrained wave (≈20× smaller for sand with real water); it needs pressureModeDamping for long runs"),
+		realAttr("pressureTolerance", &E::pressureTolerance,
+		         "Accuracy of the semi-implicit pressure solve δp [Pa], > 0, default 1e-3: the conjugate gradient stops at the residual of a pressure error δp at a typical node"),
+		stringAttr("drag", &E::drag, "Drag integration of the explicit scheme [-]: 'semi-implicit' (no drag time-step limit) or 'explicit'; the semi-implicit scheme always takes the drag implicitly"),
 		boolAttr("cellAveraging", &E::cellAveraging, "Cell-averaged volumetric rates for the pore pressure and the skeleton (suppresses the pressure checkerboard) [-]"),
 		boolAttr("pressureModeDamping", &E::pressureModeDamping,
-		         "Pore-pressure modes the grid cannot see (cell and node checkerboards, which exert no nodal force and so are never drained) relax towards the nodal average at the rate c_v/h² at which seepage drains a one-cell perturbation (theory.md eq. 4.17b), and in wall, face and surface cells towards a local linear fit at a slower rate (eq. 4.17c); off, they can grow without bound in long runs [-]"),
+		         "Explicit scheme only (default False; refused with scheme='semi-implicit', which needs no relaxation): pore-pressure modes the grid cannot see (cell and node checkerboards, which exert no nodal force and so are never drained) relax towards the nodal average at the rate c_v/h² at which seepage drains a one-cell perturbation (theory.md eq. 4.17b), and in wall, face and surface cells towards a local linear fit at a slower rate (eq. 4.17c); off, they can grow without bound in long runs [-]"),
 		realAttr("freeSurfaceThreshold", &E::freeSurfaceThreshold,
 		         "Free-surface detection β [-], 0 ≤ β < 1: water points whose filling Σ S V_water/V_full of their nodes is below β get p = 0 (0.75 keeps exactly the outer layer with 2 points per cell and axis); 0: off"),
 		boolAttr("freeSurfaceHoldsSuction", &E::freeSurfaceHoldsSuction,
-		         "With a free surface (freeSurfaceThreshold > 0): the surface keeps suction (p < 0), as capillary menisci hold the water to the grains there (no relative flow at its nodes), and releases only positive pressure, p = min(p, 0): a seepage face that lets water out but draws none in. False: p = 0 on every free-surface point, as under ponded water [-]"),
+		         "Explicit scheme only (refused with scheme='semi-implicit'). With a free surface (freeSurfaceThreshold > 0): the surface keeps suction (p < 0), as capillary menisci hold the water to the grains there (no relative flow at its nodes), and releases only positive pressure, p = min(p, 0): a seepage face that lets water out but draws none in. False: p = 0 on every free-surface point, as under ponded water [-]"),
 		fixedListAttr("solidWalls", &E::solidWalls, 6,
 		              "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0), 'fixed' or 'frictional' (a contact: pushes the grains, never pulls them, and resists sliding by Coulomb friction wallFriction × the effective normal force; a fixed wall wins on a shared edge)"),
 		fixedListAttr("wallFriction", &E::wallFriction, 6, "Coulomb friction coefficient μ = tan δ per 'frictional' face [-], ≥ 0"),
@@ -233,8 +242,9 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		readOnly(intAttr("solverSteps", &E::solverSteps, "Explicit steps since the solver was (re)built [-]")),
 		readOnly(realAttr("removedWaterMass", &E::removedWaterMass, "Water mass removed by waterSinks and at the grid's edge since the start [kg]")),
 		readOnly(realAttr("injectedWaterMass", &E::injectedWaterMass, "Water mass supplied as new water points through waterInflow faces since the start [kg]")),
+		readOnly(intAttr("pressureSolveIterations", &E::pressureSolveIterations, "Conjugate-gradient iterations of the last pressure solve of the semi-implicit scheme [-]")),
 		readOnly(realAttr("criticalTimeStep", &E::criticalTimeStep,
-		                  "Critical time step of the last run before timeStepFactor: min of the wave limit h/(fastest wave + fastest point) and, with explicit drag, the drag limit [s]")),
+		                  "Critical time step of the last run before timeStepFactor [s]: semi-implicit, h/(skeleton wave + fastest point) (theory.md eq. 8.10); explicit, min of h/(fastest wave + fastest point) and, with explicit drag, the drag limit (eqs. 5.1–5.2)")),
 	};
 	return table;
 }
@@ -255,6 +265,8 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	serializeVector3(ar, "domainMax", domainMax);
 	ar& BOOST_SERIALIZATION_NVP(cellSize);
 	ar& BOOST_SERIALIZATION_NVP(shapeFunction);
+	ar& BOOST_SERIALIZATION_NVP(scheme);
+	ar& BOOST_SERIALIZATION_NVP(pressureTolerance);
 	ar& BOOST_SERIALIZATION_NVP(drag);
 	ar& BOOST_SERIALIZATION_NVP(cellAveraging);
 	ar& BOOST_SERIALIZATION_NVP(pressureModeDamping);
@@ -285,6 +297,7 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& BOOST_SERIALIZATION_NVP(subStepsLast);
 	ar& BOOST_SERIALIZATION_NVP(solverSteps);
 	ar& BOOST_SERIALIZATION_NVP(criticalTimeStep);
+	ar& BOOST_SERIALIZATION_NVP(pressureSolveIterations);
 }
 
 } // namespace yade_mpm

@@ -24,9 +24,11 @@ public:
 	yade::Vector3r domainMax      = yade::Vector3r::Ones(); // upper corner [m]
 	yade::Real     cellSize       = 0.1;                    // h [m]
 	std::string    shapeFunction  = "uGIMP";                // linear | uGIMP | cpGIMP
+	std::string    scheme         = "semi-implicit";        // semi-implicit | explicit (pore pressure; theory.md §8, §4)
+	yade::Real     pressureTolerance = 1e-3;                // δp [Pa] > 0: accuracy of the semi-implicit pressure solve
 	std::string    drag           = "semi-implicit";        // semi-implicit | explicit
 	bool           cellAveraging  = true;                   // cell-averaged volumetric rates
-	bool           pressureModeDamping = true;              // grid-invisible pressure modes decay (theory.md eq. 4.17b)
+	bool           pressureModeDamping = false;             // explicit scheme only: grid-invisible pressure modes decay (theory.md eq. 4.17b)
 	yade::Real     freeSurfaceThreshold = 0;                // β [-]: p = 0 on water points filled below β; 0 off
 	bool           freeSurfaceHoldsSuction = false;         // the free surface keeps suction, releases only p > 0 (seepage face)
 	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed | frictional
@@ -50,6 +52,7 @@ public:
 	long       subStepsLast    = 0;  // sub-steps of the last action() [-]
 	long       solverSteps     = 0;  // explicit steps since the solver was set up [-]
 	yade::Real criticalTimeStep = 0; // critical step of the last action(), before timeStepFactor [s]
+	long       pressureSolveIterations = 0; // conjugate-gradient iterations of the last pressure solve (semi-implicit) [-]
 	yade::Real removedWaterMass = 0; // water mass removed by sinks and at the grid's edge, in total [kg]
 	yade::Real injectedWaterMass = 0; // water mass supplied through inflow faces, in total [kg]
 
@@ -69,7 +72,7 @@ public:
 private:
 	// Everything the solver is built from except the values held on drained faces, which a
 	// running solver takes over in place (a rising head set every step must not rebuild it).
-	using Structure = std::tuple<yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, bool, yade::Real, bool,
+	using Structure = std::tuple<std::string, yade::Real, yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, bool, yade::Real, bool,
 	                             std::vector<std::string>, std::vector<yade::Real>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>, std::vector<int>>;
 	Structure structure() const;
 

@@ -11,7 +11,7 @@ from yade_mpm import analytical
 G = np.array([0.0, 0.0, -9.81])
 
 
-def column(height, cell, permeability=1e-10, bulk_modulus=2.2e8, geostatic=True):
+def column(height, cell, permeability=1e-10, bulk_modulus=2.2e8, geostatic=True, scheme="semi-implicit"):
     soil = w.MpmSoilMat(density=2650, youngModulus=20e6, poissonRatio=0.3, porosity=0.4, intrinsicPermeability=permeability)
     water = w.MpmWaterMat(density=1000, bulkModulus=bulk_modulus, viscosity=1e-3)
     O.materials.append([soil, water])
@@ -19,7 +19,7 @@ def column(height, cell, permeability=1e-10, bulk_modulus=2.2e8, geostatic=True)
                                             gravity=G, geostatic=geostatic)
     O.bodies.append([solid, fluid])
     engine = w.MpmTwoPhaseEngine(label="mpm", gravity=G, domainMin=(0, 0, 0), domainMax=(cell, cell, height), cellSize=cell,
-                                 solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("drained",))
+                                 solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("drained",), scheme=scheme)
     O.engines = [engine]
     return soil, water, solid.shape, fluid.shape, engine
 
@@ -45,12 +45,16 @@ def test_hydrostatic_column_stays_at_rest():
     assert engine.subStepsLast >= 1 and engine.mpmTime == pytest.approx(0.04)
 
 
-def test_engine_sub_steps_to_the_critical_time_step():
-    soil, water, solid, fluid, engine = column(0.5, 0.05)
+@pytest.mark.parametrize("scheme", ["semi-implicit", "explicit"])
+def test_engine_sub_steps_to_the_critical_time_step(scheme):
+    soil, water, solid, fluid, engine = column(0.5, 0.05, scheme=scheme)
     O.dt = 1e-3
     O.step()
-    wave = analytical.undrained_wave_speed(20e6, 0.3, 0.4, 2650, 1000, 2.2e8)
-    # critical step is h over the fastest wave (the undrained P wave here; points at rest)
+    if scheme == "explicit":  # h over the fastest wave: the undrained P wave here (points at rest), theory.md eq. 5.1
+        wave = analytical.undrained_wave_speed(20e6, 0.3, 0.4, 2650, 1000, 2.2e8)
+    else:  # the pressure is implicit: h over the skeleton's own P wave, theory.md eq. 8.10
+        e_oed = 20e6 * 0.7 / (1.3 * 0.4)
+        wave = np.sqrt(e_oed / (0.6 * 2650))
     assert engine.criticalTimeStep == pytest.approx(0.05 / wave, rel=1e-9)
     assert engine.subStepsLast == int(np.ceil(1e-3 / (engine.timeStepFactor * engine.criticalTimeStep)))
 
@@ -166,7 +170,9 @@ def test_inflow_face_supplies_water_points_under_a_raised_head_and_the_balance_c
     points, a sink above the column takes the outflow, and mass stored + out = initial + in to
     round-off. Raising the head (drainedWaterTable) mid-run updates the running solver in place."""
     height, cell = 0.3, 0.05
-    soil, water, solid, fluid, engine = column(height, cell, permeability=0.05 * 1e-3 / (1000 * 9.81), bulk_modulus=2.2e7)
+    # validated on the explicit scheme; the semi-implicit one does not yet hold a drained base with
+    # a raised head (theory.md §8.5, open)
+    soil, water, solid, fluid, engine = column(height, cell, permeability=0.05 * 1e-3 / (1000 * 9.81), bulk_modulus=2.2e7, scheme="explicit")
     engine.waterWalls = ("impermeable",) * 4 + ("drained", "drained")
     with pytest.raises(ValueError, match=r"waterInflow\[zMax\].*'drained'"):
         engine.waterInflow = (False,) * 4 + (False, True)
