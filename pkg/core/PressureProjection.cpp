@@ -84,16 +84,20 @@ namespace stages {
 			} else if (open) {
 				system.fixed[r] = 1;
 			} else {
+				// a free surface (eq. 2.3 at the node), or a node beyond a wall, whose support lies
+				// outside the domain and which points reach only by the round-off tail of their
+				// weights: left free, its pressure is all but undetermined, and a solid point a hair
+				// closer to the wall than its water point would pick it up
 				const Real full = grid.inDomainSupportVolume(idx[0], idx[1], idx[2]);
-				if (full > 0 && fields.water[I].volume < freeSurfaceFilling * full) system.fixed[r] = 1; // eq. 2.3 at the node
+				if (!(full > 0) || fields.water[I].volume < freeSurfaceFilling * full) system.fixed[r] = 1;
 			}
 		}
 	}
 
 	template <class Kernel>
-	void assemblePressureSystem(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const WaterParameters& water,
-	                            const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
-	                            Real waterMassTolerance, PressureSystem& system)
+	void assemblePressureSystem(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, const std::vector<WaterPointSet*>& sets,
+	                            const WaterParameters& water, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
+	                            Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system)
 	{
 		constexpr int S = Kernel::stencil;
 		const Real    rhoWater = water.density;
@@ -133,8 +137,8 @@ namespace stages {
 				int node[3][S];
 				stencilNodes(grid, w, node);
 				// the solid fields at the water point (eqs. 4.5, 8.5) and the predicted velocities
-				Real n = 0, divS = 0, divW = 0;
-				Vec3 gradn = Vec3::Zero(), vs = Vec3::Zero(), vw = Vec3::Zero(), lambda = Vec3::Zero();
+				Real n = 0, divW = 0;
+				Vec3 gradn = Vec3::Zero(), vw = Vec3::Zero(), lambda = Vec3::Zero();
 				Real N[S][S][S];
 				Vec3 dN[S][S][S];
 				for (int c = 0; c < S; ++c)
@@ -148,16 +152,14 @@ namespace stages {
 							n += Ni * fields.porosity[I];
 							gradn += fields.porosity[I] * dN[c][b][a];
 							lambda += Ni * system.mobility[I];
-							vs += Ni * fields.solidVelocityNew[I];
 							vw += Ni * fields.waterVelocityNew[I];
-							divS += fields.solidVelocityNew[I].dot(dN[c][b][a]);
 							divW += fields.waterVelocityNew[I].dot(dN[c][b][a]);
 						}
 				n        = std::clamp<Real>(n, 1e-5, 1);
 				gradN[p] = gradn;
 				const Real V = P.volume[p];
-				// eq. 8.2: the divergence of the mixture's volume flux, with the (vw − vs)·∇n term of E2′
-				const Real divergence = (1 - n) * divS + n * divW + (vw - vs).dot(gradn);
+				// eq. 8.2, the water's share: n∇·vw + vw·∇n (the solid's is added at the solid points below)
+				const Real divergence = n * divW + vw.dot(gradn);
 				const Real storage    = V * n * invKw / dt; // C/Δt (eq. 8.3), consistent: Σ V S_J S_K n/(Kw Δt)
 				const Vec3 conductance = dt * V * lambda;    // Δt L (eq. 8.6), per axis
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n
@@ -173,6 +175,31 @@ namespace stages {
 									for (int aa = 0; aa < S; ++aa)
 										r[offsetSlot(aa - a, bb - b, cc - c)] += storage * Nj * N[cc][bb][aa] + dN[c][b][a].dot(conductance.cwiseProduct(dN[cc][bb][aa]));
 						}
+			});
+		}
+		// the solid's share of the volume balance, (1 − n)∇·vs − vs·∇n, at the solid points (eq. 8.2):
+		// each phase's terms are integrated with its own points, so the volume change the constraint
+		// sees for the skeleton is the one the skeleton's points feel
+		for (const SolidSet& set : solids) {
+			const SolidPointSet& P = *set.points;
+			scatter(system.rows, system.rowBuffers, P.size(), [&](std::size_t p, Real* rows) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				Real n = 0, divS = 0;
+				Vec3 gradn = Vec3::Zero(), vs = Vec3::Zero();
+				bool reaches = false;
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					n += N * fields.porosity[I];
+					gradn += fields.porosity[I] * dN;
+					vs += N * fields.solidVelocityNew[I];
+					divS += fields.solidVelocityNew[I].dot(dN);
+					reaches = reaches || system.row[I] >= 0;
+				});
+				if (!reaches) return;
+				const Real source = P.volume[p] * ((1 - n) * divS - vs.dot(gradn));
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+					if (system.row[I] >= 0) rows[static_cast<std::size_t>(system.row[I]) * PressureSystem::rowStride + PressureSystem::rhsSlot] -= N * source;
+				});
 			});
 		}
 	}
@@ -302,9 +329,9 @@ namespace stages {
 	}
 
 	template <class Kernel>
-	void correctVelocities(const GridGeometry& grid, GridFields& fields, std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
-	                       const Vec3& gravity, Real waterDensity, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid,
-	                       Real dt, Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system)
+	void correctVelocities(const GridGeometry& grid, GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                       const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, const ConstrainedNodes& constrained,
+	                       const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system)
 	{
 		const std::vector<Real>& pressure = system.nodalPressure;
 		system.forces.assign(grid.nodeCount(), zeroOf(PressureForceNode {}));
@@ -321,10 +348,27 @@ namespace stages {
 				const Vec3 gn = gradN[p];
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 					nodes[I].water += Vq * (n * dN + N * gn);       // eq. 8.1: ∇(n S_I)
-					nodes[I].solid += Vq * ((1 - n) * dN - N * gn); // ∇((1 − n) S_I)
+
 				});
 			});
 		}
+		// g^s at the solid points, ∇((1 − n) S_I) (eq. 8.1): the adjoint of the solid's share above
+		for (const SolidSet& set : solids) {
+				const SolidPointSet& P = *set.points;
+				scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
+					Weights1D w[3];
+					weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+					Real q = 0, n = 0;
+					Vec3 gn = Vec3::Zero();
+					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+						q += N * pressure[I];
+						n += N * fields.porosity[I];
+						gn += fields.porosity[I] * dN;
+					});
+					const Real Vq = P.volume[p] * q;
+					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) { nodes[I].solid += Vq * ((1 - n) * dN - N * gn); });
+				});
+			}
 		// the boundary terms of drained faces with p̄ ≠ 0 (eq. 2.2): −∮ N n p̄ n̂ on the water, the
 		// rest of −∮ N p̄ n̂ on the solid. They belong with the pressure forces: in the predictor they
 		// would meet no pressure gradient and throw the face nodes' water far off before the solve.
@@ -382,9 +426,11 @@ namespace stages {
 #define MPM_INSTANTIATE_PROJECTION(K)                                                                                                      \
 	template void classifyPressureNodes<K>(const GridGeometry&, const GridFields&, const std::vector<WaterPointSet*>&, const BoundaryConditions&, \
 	                                       const Vec3&, Real, PressureSystem&);                                                         \
-	template void assemblePressureSystem<K>(const GridGeometry&, const GridFields&, const std::vector<WaterPointSet*>&, const WaterParameters&,  \
-	                                        const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real, PressureSystem&);  \
-	template void correctVelocities<K>(const GridGeometry&, GridFields&, std::vector<WaterPointSet*>&, const BoundaryConditions&,            \
+	template void assemblePressureSystem<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, const std::vector<WaterPointSet*>&, \
+	                                        const WaterParameters&, const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,  \
+	                                        PressureSystem&);                                                                                     \
+	template void correctVelocities<K>(const GridGeometry&, GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&,         \
+	                                   const BoundaryConditions&,                                                                             \
 	                                   const Vec3&, Real, const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,  \
 	                                   PressureSystem&);
 

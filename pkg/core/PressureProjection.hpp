@@ -90,9 +90,9 @@ namespace stages {
 	// with the phases held by walls (`heldSolid`, the water constraints) out of its 2×2 system, and
 	// interpolated to the points.
 	template <class Kernel>
-	void assemblePressureSystem(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const WaterParameters& water,
-	                            const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
-	                            Real waterMassTolerance, PressureSystem& system);
+	void assemblePressureSystem(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, const std::vector<WaterPointSet*>& sets,
+	                            const WaterParameters& water, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
+	                            Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system);
 
 	// The free rows of eq. 8.7 as a sparse (CSR) matrix and right-hand side, the prescribed
 	// pressures moved to the right-hand side: what a linear solver needs, nothing of the grid.
@@ -110,9 +110,9 @@ namespace stages {
 	// increments of the 2×2 drag system, with the wall
 	// holds of the predictor (`heldSolid` per constrained node).
 	template <class Kernel>
-	void correctVelocities(const GridGeometry& grid, GridFields& fields, std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
-	                       const Vec3& gravity, Real waterDensity, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid,
-	                       Real dt, Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system);
+	void correctVelocities(const GridGeometry& grid, GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                       const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, const ConstrainedNodes& constrained,
+	                       const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system);
 
 	// Mobility λ per unit volume of eq. 8.5 [m³ kg⁻¹]: [1−n, n] M⁻¹ [1−n, n]ᵀ of the nodal 2×2
 	// system per unit volume, with partial densities (1−n)ρs, nρw and drag Q̂Δt (Q̂ = n²μw/κ).

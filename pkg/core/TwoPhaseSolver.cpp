@@ -224,7 +224,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 		{
 			StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.1–8.7
 			classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, pressureSystem_);
-			assemblePressureSystem<Kernel>(grid_, fields_, waters_, water_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
+			assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, water_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
 			                               pressureSystem_);
 			buildPressureMatrix(grid_, pressureSystem_);
 		}
@@ -234,7 +234,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 		}
 		{
 			StageTimer t(stageSeconds_, Stage::CorrectVelocities); // eq. 8.8, then the wall friction (eq. 2.6) once
-			correctVelocities<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, constrained_, heldSolid_, dt, solidMassTolerance_,
+			correctVelocities<Kernel>(grid_, fields_, solids_, waters_, domain_.boundaries, g, water_.density, constrained_, heldSolid_, dt, solidMassTolerance_,
 			                          waterMassTolerance_, pressureSystem_);
 			applyWallFriction(fields_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_);
 		}
