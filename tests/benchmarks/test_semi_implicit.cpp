@@ -3,6 +3,7 @@
 // and for incompressible water, and at small cells, at the step the semi-implicit limit allows
 // (eq. 8.10) — steps the explicit scheme could only take 20 to 2000 times over.
 #include "core/TwoPhaseSolver.hpp"
+#include "support/AnalyticalSolutions.hpp"
 #include "support/Fixtures.hpp"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 
 namespace {
 
@@ -124,6 +126,61 @@ TEST(SemiImplicitCheckerboard, StripLoadOnALowPermeabilityLayerLeavesNoCheckerbo
 	EXPECT_LT(worst, 0.01 * q);
 	// and the load is really carried by the water (undrained): a large share of q under the strip
 	EXPECT_GT(loadedExcess, 0.3 * q);
+}
+
+// The soil's own surface as the drained face (theory.md §8.5): Terzaghi's column with no drained
+// wall at all, its surface two cells below the domain's top: the load's excess pressure drains
+// through the surface, whose nodes (filling below 0.75) take p = 0. Pressures and the degree of
+// consolidation follow the series as with a drained face; water mass is kept to round-off.
+TEST(SoilSurface, ConsolidationDrainsThroughTheSoilSurface)
+{
+	const double    h = 0.05, H = 1.0, q = 10e3;
+	SoilParameters  soil;
+	WaterParameters water; // real water
+	soil.porosity              = 0.3;
+	soil.intrinsicPermeability = 1e-3 * water.viscosity / (water.density * 9.81);
+	const double Ec = soil.constrainedModulus(), n = soil.porosity, Kw = water.bulkModulus;
+	const double p0 = q * analytical::undrainedPressureRatio(Ec, n, Kw);
+	const double cv = analytical::consolidationCoefficient(soil.intrinsicPermeability / water.viscosity, Ec, n, Kw);
+	const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(h, h, H), h, 2);
+	SolidPointSet solid = fixtures::solidLattice(l, n, soil.density);
+	WaterPointSet fluid = fixtures::waterLattice(l, n, water.density);
+	const double  sz = -(q - p0), sx = soil.poissonRatio / (1 - soil.poissonRatio) * sz, area = l.spacing * l.spacing;
+	for (std::size_t p = 0; p < solid.size(); ++p) {
+		solid.effectiveStress[p] << sx, sx, sz, 0, 0, 0;
+		fluid.porePressure[p] = p0;
+		if (solid.position[p].z() > H - l.spacing) solid.externalForce[p] = Vec3(0, 0, -q * area);
+	}
+	Domain d = fixtures::columnDomain(Vec3(h, h, H + 2 * h), h);
+	d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Free };
+	SolverSettings s;
+	TwoPhaseSolver solver(d, s);
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	const double initialWater = std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0);
+	const double dt = 0.5 * solver.timeStepLimits().critical;
+	double       t  = 0;
+	for (double Tv : { 0.1, 0.2, 0.5, 1.0 }) {
+		const double target = Tv * H * H / cv;
+		while (t < target - 1e-12) {
+			const double step = std::min(dt, target - t);
+			solver.step(step);
+			t += step;
+		}
+		double err = 0, pv = 0, v = 0;
+		for (std::size_t p = 0; p < fluid.size(); ++p) {
+			err = std::max(err, std::abs(fluid.porePressure[p] - p0 * analytical::terzaghiPressureRatio((H - fluid.position[p].z()) / H, Tv)) / p0);
+			pv += fluid.porePressure[p] * fluid.volume[p];
+			v += fluid.volume[p];
+		}
+		double top = 0;
+		for (std::size_t p = 0; p < solid.size(); ++p) top = std::max(top, solid.position[p].z());
+		const double stored = std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0);
+		std::printf("Tv %.2f: max |p - p_exact|/p0 %.4f, U %.4f (exact %.4f), settlement %.3e m\n", Tv, err, 1 - pv / (p0 * v),
+		            analytical::terzaghiDegree(Tv), H - l.spacing / 2 - top);
+		EXPECT_LT(err, 0.01) << "Tv = " << Tv;
+		EXPECT_NEAR(1 - pv / (p0 * v), analytical::terzaghiDegree(Tv), 0.01) << "Tv = " << Tv;
+		EXPECT_NEAR(stored + solver.removedWaterMass(), initialWater, 1e-12 * initialWater);
+	}
 }
 
 } // namespace
