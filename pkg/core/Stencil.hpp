@@ -7,6 +7,7 @@
 
 #include <omp.h>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -88,6 +89,13 @@ namespace mpm::detail {
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 		for (std::size_t i = 0; i < nodes; ++i)
 			for (auto& b : buffers) target[i] += b[i];
+	}
+
+	// Lower node (i, j, k) of the cell holding x.
+	inline std::array<int, 3> cellOf(const GridGeometry& grid, const Vec3& x)
+	{
+		const Vec3 u = (x - grid.origin) / grid.cellSize;
+		return { static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])), static_cast<int>(std::floor(u[2])) };
 	}
 
 } // namespace mpm::detail

@@ -189,56 +189,80 @@ void TwoPhaseSolver::step(Real dt)
 
 // One step, MUSL with FLIP/PIC blend: explicit (theory.md §4, Steps 0–11) or semi-implicit, where
 // Step 6 becomes predictor, pressure solve and corrector and Step 10 moves only the water volume
-// (theory.md §8.3).
+// (theory.md §8.3). A dry scene (no water points) skips every water stage and the drag.
 template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 {
+	const bool wet = !waters_.empty(), semiImplicit = wet && settings_.scheme == TimeScheme::SemiImplicit;
+	resetGridStage(wet);                          // Step 0
+	mapPointsToGrid<Kernel>(wet);                 // Steps 1–5, eqs. 4.1–4.7
+	integrateMomentum(dt, wet, semiImplicit);     // Step 6, eqs. 4.8–4.10 (semi-implicit: predictor S1)
+	if (semiImplicit) projectPressure<Kernel>(dt); // S2–S3, eqs. 8.7–8.8
+	movePoints<Kernel>(dt);                       // Step 7, eq. 4.11; water in and out, eqs. 2.4–2.5
+	remap<Kernel>(wet);                           // Step 8, eq. 4.12
+	updateSkeleton<Kernel>(dt);                   // Step 9, eqs. 4.13–4.15, §7
+	updateWater<Kernel>(dt, semiImplicit);        // Step 10, eqs. 4.16–4.17c, 2.1, 2.3 (semi-implicit: S4, the volume only)
+	updateDomains();                              // Step 11, eq. 3.3
+}
+
+void TwoPhaseSolver::resetGridStage(bool wet)
+{
+	StageTimer t(stageSeconds_, Stage::ResetGrid);
+	stages::resetGrid(fields_, wet || !waterFieldsZero_);
+	waterFieldsZero_ = !wet;
+}
+
+template <class Kernel> void TwoPhaseSolver::mapPointsToGrid(bool wet)
+{
 	using namespace stages;
-	const Vec3& g   = settings_.gravity;
-	const bool  wet = !waters_.empty(); // a dry scene skips every water stage and the drag
-	{
-		StageTimer t(stageSeconds_, Stage::ResetGrid);
-		resetGrid(fields_, wet || !waterFieldsZero_);
-		waterFieldsZero_ = !wet;
-	}
+	const Vec3& g = settings_.gravity;
 	{
 		StageTimer t(stageSeconds_, Stage::MapSolidToGrid);
 		mapSolidToGrid<Kernel>(grid_, solids_, wet ? &water_ : nullptr, g, fields_, workspace_);
 		if (wet) computeNodalPorosity(fields_);
 	}
-	if (wet) {
-		StageTimer t(stageSeconds_, Stage::MapWaterToGrid);
-		mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_, settings_.scheme == TimeScheme::Explicit);
-		// semi-implicit: these are pore-pressure forces too, applied with the others in the corrector
-		if (settings_.scheme == TimeScheme::Explicit) addDrainedFaceTractions(grid_, domain_.boundaries, g, water_.density, waterMassTolerance_, fields_);
-	}
-	const bool semiImplicit = wet && settings_.scheme == TimeScheme::SemiImplicit;
+	if (!wet) return;
+	StageTimer t(stageSeconds_, Stage::MapWaterToGrid);
+	const bool explicitScheme = settings_.scheme == TimeScheme::Explicit;
+	mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_, explicitScheme);
+	// semi-implicit: these are pore-pressure forces too, applied with the others in the corrector
+	if (explicitScheme) addDrainedFaceTractions(grid_, domain_.boundaries, g, water_.density, waterMassTolerance_, fields_);
+}
+
+void TwoPhaseSolver::integrateMomentum(Real dt, bool wet, bool semiImplicit)
+{
+	using namespace stages;
+	StageTimer t(stageSeconds_, Stage::IntegrateNodalMomentum);
+	computeNodalVelocities(fields_, solidMassTolerance_, waterMassTolerance_);
+	const bool holdSuction = wet && settings_.freeSurfaceHoldsSuction;
+	if (holdSuction) markSuctionHoldingNodes(grid_, fields_, settings_.freeSurfaceThreshold, solidMassTolerance_, waterMassTolerance_, suctionHolding_);
+	// the semi-implicit step applies the wall friction once, after the corrector
+	integrateNodalMomentum(fields_, constrained_, dt, settings_.drag, solidMassTolerance_, waterMassTolerance_, holdSuction ? &suctionHolding_ : nullptr,
+	                       !semiImplicit, &heldSolid_);
+}
+
+template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
+{
+	using namespace stages;
+	const Vec3& g = settings_.gravity;
 	{
-		StageTimer t(stageSeconds_, Stage::IntegrateNodalMomentum); // explicit: eqs. 4.8–4.10; semi-implicit: predictor S1 (eq. 8.7)
-		computeNodalVelocities(fields_, solidMassTolerance_, waterMassTolerance_);
-		const bool holdSuction = wet && settings_.freeSurfaceHoldsSuction;
-		if (holdSuction) markSuctionHoldingNodes(grid_, fields_, settings_.freeSurfaceThreshold, solidMassTolerance_, waterMassTolerance_, suctionHolding_);
-		integrateNodalMomentum(fields_, constrained_, dt, settings_.drag, solidMassTolerance_, waterMassTolerance_, holdSuction ? &suctionHolding_ : nullptr,
-		                       !semiImplicit, &heldSolid_);
+		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.1–8.7
+		classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, pressureSystem_);
+		assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, water_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
+		                               pressureSystem_);
+		buildPressureMatrix(grid_, pressureSystem_);
 	}
-	if (semiImplicit) {
-		{
-			StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.1–8.7
-			classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, pressureSystem_);
-			assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, water_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
-			                               pressureSystem_);
-			buildPressureMatrix(grid_, pressureSystem_);
-		}
-		{
-			StageTimer t(stageSeconds_, Stage::SolvePressure); // eq. 8.7
-			lastPressureSolve_ = solvePressure(pressureSystem_, settings_.pressureTolerance);
-		}
-		{
-			StageTimer t(stageSeconds_, Stage::CorrectVelocities); // eq. 8.8, then the wall friction (eq. 2.6) once
-			correctVelocities<Kernel>(grid_, fields_, solids_, waters_, domain_.boundaries, g, water_.density, constrained_, heldSolid_, dt, solidMassTolerance_,
-			                          waterMassTolerance_, pressureSystem_);
-			applyWallFriction(fields_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_);
-		}
+	{
+		StageTimer t(stageSeconds_, Stage::SolvePressure); // eq. 8.7
+		lastPressureSolve_ = solvePressure(pressureSystem_, settings_.pressureTolerance);
 	}
+	StageTimer t(stageSeconds_, Stage::CorrectVelocities); // eq. 8.8, then the wall friction (eq. 2.6) once
+	correctVelocities<Kernel>(grid_, fields_, solids_, waters_, domain_.boundaries, g, water_.density, constrained_, heldSolid_, dt, solidMassTolerance_,
+	                          waterMassTolerance_, pressureSystem_);
+	applyWallFriction(fields_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_);
+}
+
+template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
+{
 	{
 		StageTimer t(stageSeconds_, Stage::UpdatePointKinematics);
 		auto check = [&](long bad, const char* phase, std::size_t set, const MaterialPointSet& points) {
@@ -252,65 +276,77 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 			throw InstabilityError(msg.str());
 		};
 		for (std::size_t s = 0; s < solids_.size(); ++s)
-			check(updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, *solids_[s].points, dt, settings_.flipBlend), "solid", s,
-			      *solids_[s].points);
+			check(stages::updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, *solids_[s].points, dt, settings_.flipBlend),
+			      "solid", s, *solids_[s].points);
 		for (std::size_t w = 0; w < waters_.size(); ++w)
-			check(updatePointKinematics<Kernel>(grid_, fields_.waterVelocity, fields_.waterVelocityNew, *waters_[w], dt, settings_.flipBlend), "water", w,
-			      *waters_[w]);
+			check(stages::updatePointKinematics<Kernel>(grid_, fields_.waterVelocity, fields_.waterVelocityNew, *waters_[w], dt, settings_.flipBlend), "water",
+			      w, *waters_[w]);
 	}
 	removeOutflowingWater();
 	injectInflowingWater();
 	throwIfOutsideGrid();
-	{
-		StageTimer                           t(stageSeconds_, Stage::RemapVelocities);
-		std::vector<const MaterialPointSet*> solidSets, waterSets;
-		for (const SolidSet& s : solids_) solidSets.push_back(s.points);
-		for (const WaterPointSet* w : waters_) waterSets.push_back(w);
-		remapVelocities<Kernel>(grid_, solidSets, solidMassTolerance_, constrained_, true, fields_.solidVelocityNew, workspace_);
-		if (wet) remapVelocities<Kernel>(grid_, waterSets, waterMassTolerance_, constrained_, false, fields_.waterVelocityNew, workspace_);
-	}
+}
+
+template <class Kernel> void TwoPhaseSolver::remap(bool wet)
+{
+	StageTimer                           t(stageSeconds_, Stage::RemapVelocities);
+	std::vector<const MaterialPointSet*> solidSets, waterSets;
+	for (const SolidSet& s : solids_) solidSets.push_back(s.points);
+	for (const WaterPointSet* w : waters_) waterSets.push_back(w);
+	stages::remapVelocities<Kernel>(grid_, solidSets, solidMassTolerance_, constrained_, true, fields_.solidVelocityNew, workspace_);
+	if (wet) stages::remapVelocities<Kernel>(grid_, waterSets, waterMassTolerance_, constrained_, false, fields_.waterVelocityNew, workspace_);
+}
+
+template <class Kernel> void TwoPhaseSolver::updateSkeleton(Real dt)
+{
+	using namespace stages;
+	StageTimer t(stageSeconds_, Stage::UpdateSolidStress);
 	const bool average = settings_.cellAveragedVolumetricRate;
-	{
-		StageTimer t(stageSeconds_, Stage::UpdateSolidStress);
-		for (SolidSet& s : solids_) {
-			computeVelocityGradients<Kernel>(grid_, fields_.solidVelocityNew, *s.points, velocityGradients_);
-			if (average) {
-				volumetricRate_.resize(velocityGradients_.size());
-				for (std::size_t p = 0; p < velocityGradients_.size(); ++p) volumetricRate_[p] = velocityGradients_[p].trace();
-				averageOverCells(grid_, *s.points, volumetricRate_, cellSum_, cellVolume_);
-			}
-			updateSolidStress(velocityGradients_, average ? &volumetricRate_ : nullptr, s, dt);
+	for (SolidSet& s : solids_) {
+		computeVelocityGradients<Kernel>(grid_, fields_.solidVelocityNew, *s.points, velocityGradients_);
+		if (average) {
+			volumetricRate_.resize(velocityGradients_.size());
+			for (std::size_t p = 0; p < velocityGradients_.size(); ++p) volumetricRate_[p] = velocityGradients_[p].trace();
+			averageOverCells(grid_, *s.points, volumetricRate_, cellSum_, cellVolume_);
 		}
+		updateSolidStress(velocityGradients_, average ? &volumetricRate_ : nullptr, s, dt);
 	}
-	{
-		StageTimer t(stageSeconds_, Stage::UpdatePorePressure);
-		for (WaterPointSet* w : waters_) {
-			computePressureRates<Kernel>(grid_, fields_.solidVelocityNew, fields_.waterVelocityNew, *w, water_, pressureRate_, waterDivergence_);
-			if (average) {
-				if (!semiImplicit) averageOverCells(grid_, *w, pressureRate_, cellSum_, cellVolume_);
-				averageOverCells(grid_, *w, waterDivergence_, cellSum_, cellVolume_);
-			}
-			// semi-implicit: the pressure was advanced by the projection (eq. 8.8); only the volume moves here
-			if (semiImplicit) std::fill(pressureRate_.begin(), pressureRate_.end(), 0.0);
-			updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
-			const bool damped = settings_.pressureModeDamping && pressureDiffusivity_ > 0;
-			if (damped) {
-				const Real rate = dt * pressureDiffusivity_ / (grid_.cellSize * grid_.cellSize);
-				dampPressureModes<Kernel>(grid_, fields_, std::min<Real>(1, rate), std::min<Real>(edgeRelaxLimit, edgeDampingShare * rate),
-				                          settings_.freeSurfaceThreshold, *w, pressureModes_, workspace_);
-			}
-			// semi-implicit: the points carry the interpolated solution, which holds the faces and the
-			// free surface at their nodes (theory.md §8.5); explicit: the points are reset (eqs. 2.1, 2.3)
-			if (semiImplicit) continue;
-			if (settings_.freeSurfaceThreshold > 0)
-				applyFreeSurface(grid_, fields_, settings_.freeSurfaceThreshold, settings_.freeSurfaceHoldsSuction, *w, damped ? &pressureModes_.kind : nullptr);
-			applyDrainedFaces(grid_, domain_.boundaries, settings_.gravity, water_.density, *w);
+}
+
+template <class Kernel> void TwoPhaseSolver::updateWater(Real dt, bool semiImplicit)
+{
+	using namespace stages;
+	StageTimer t(stageSeconds_, Stage::UpdatePorePressure);
+	const bool average = settings_.cellAveragedVolumetricRate;
+	for (WaterPointSet* w : waters_) {
+		computePressureRates<Kernel>(grid_, fields_.solidVelocityNew, fields_.waterVelocityNew, *w, water_, pressureRate_, waterDivergence_);
+		if (average) {
+			if (!semiImplicit) averageOverCells(grid_, *w, pressureRate_, cellSum_, cellVolume_);
+			averageOverCells(grid_, *w, waterDivergence_, cellSum_, cellVolume_);
 		}
+		// semi-implicit: the pressure was advanced by the projection (eq. 8.8); only the volume moves here
+		if (semiImplicit) std::fill(pressureRate_.begin(), pressureRate_.end(), 0.0);
+		updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
+		// semi-implicit: the points carry the interpolated solution, which holds the faces and the
+		// free surface at their nodes (theory.md §8.5); explicit: relaxations and resets (eqs. 4.17b–c, 2.1, 2.3)
+		if (semiImplicit) continue;
+		const bool damped = settings_.pressureModeDamping && pressureDiffusivity_ > 0;
+		if (damped) {
+			const Real rate = dt * pressureDiffusivity_ / (grid_.cellSize * grid_.cellSize);
+			dampPressureModes<Kernel>(grid_, fields_, std::min<Real>(1, rate), std::min<Real>(edgeRelaxLimit, edgeDampingShare * rate),
+			                          settings_.freeSurfaceThreshold, *w, pressureModes_, workspace_);
+		}
+		if (settings_.freeSurfaceThreshold > 0)
+			applyFreeSurface(grid_, fields_, settings_.freeSurfaceThreshold, settings_.freeSurfaceHoldsSuction, *w, damped ? &pressureModes_.kind : nullptr);
+		applyDrainedFaces(grid_, domain_.boundaries, settings_.gravity, water_.density, *w);
 	}
-	if (settings_.shapeFunction == ShapeFunction::CpGimp) {
-		StageTimer t(stageSeconds_, Stage::UpdateDomains);
-		for (SolidSet& s : solids_) updateDomainsCpGimp(*s.points, grid_.cellSize);
-	}
+}
+
+void TwoPhaseSolver::updateDomains()
+{
+	if (settings_.shapeFunction != ShapeFunction::CpGimp) return;
+	StageTimer t(stageSeconds_, Stage::UpdateDomains);
+	for (SolidSet& s : solids_) stages::updateDomainsCpGimp(*s.points, grid_.cellSize);
 }
 
 // Water points in a sink, free water (when asked: it has left the soil, as into a filtering

@@ -101,6 +101,16 @@ public:
 
 private:
 	template <class Kernel> void stepWith(Real dt);
+	// the stages of one step, in order (theory.md §4 and §8.3); each times itself
+	void                         resetGridStage(bool wet);
+	template <class Kernel> void mapPointsToGrid(bool wet);
+	void                         integrateMomentum(Real dt, bool wet, bool semiImplicit);
+	template <class Kernel> void projectPressure(Real dt);
+	template <class Kernel> void movePoints(Real dt);
+	template <class Kernel> void remap(bool wet);
+	template <class Kernel> void updateSkeleton(Real dt);
+	template <class Kernel> void updateWater(Real dt, bool semiImplicit);
+	void                         updateDomains();
 	void                         throwIfOutsideGrid() const;
 
 	Domain                        domain_;

@@ -159,6 +159,6 @@ TEST(TerzaghiSemiImplicit, RealWaterAtTwentyTimesTheExplicitStep)
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, TerzaghiConsolidation, ::testing::Values(TimeScheme::SemiImplicit, TimeScheme::Explicit),
-                         [](const auto& info) { return info.param == TimeScheme::SemiImplicit ? "semiImplicit" : "explicit"; });
+                         [](const auto& param) { return std::string(fixtures::schemeName(param.param)); });
 
 } // namespace

@@ -75,6 +75,6 @@ TEST_P(Threads, ResultsIndependentOfThreadCountToRoundOff)
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, Threads, ::testing::Values(TimeScheme::SemiImplicit, TimeScheme::Explicit),
-                         [](const auto& info) { return info.param == TimeScheme::SemiImplicit ? "semiImplicit" : "explicit"; });
+                         [](const auto& param) { return std::string(fixtures::schemeName(param.param)); });
 
 } // namespace

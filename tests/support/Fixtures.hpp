@@ -83,4 +83,7 @@ inline Domain columnDomain(const Vec3& size, Real cellSize)
 	return d;
 }
 
+// The name a parameterised test gets for each scheme.
+inline const char* schemeName(TimeScheme scheme) { return scheme == TimeScheme::SemiImplicit ? "semiImplicit" : "explicit"; }
+
 } // namespace mpm::fixtures

@@ -1,0 +1,233 @@
+// The pore pressure at the water points of the explicit scheme (doc/theory.md §4, Step 10, eqs.
+// 4.16–4.17c, 2.3): the volume-balance rate, its update, the pressure-mode damping and the free
+// surface. (The semi-implicit pressure lives in PressureProjection.cpp.)
+#include "Stages.hpp"
+
+#include "Stencil.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+
+namespace mpm {
+
+namespace stages {
+	using namespace detail;
+
+	// A water point's filling (eq. 2.3): Σ S_I (water volume of I / full support volume of I).
+	static Real waterFilling(const GridGeometry& grid, const GridFields& fields, const Vec3& position, const Vec3& halfLength)
+	{
+		Weights1D w[3];
+		weightsAt<GimpKernel>(grid, position, halfLength, w);
+		int node[3][GimpKernel::stencil];
+		stencilNodes(grid, w, node);
+		Real filling = 0;
+		for (int c = 0; c < GimpKernel::stencil; ++c)
+			for (int b = 0; b < GimpKernel::stencil; ++b)
+				for (int a = 0; a < GimpKernel::stencil; ++a) {
+					const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
+					if (N <= 0) continue;
+					const int  i = node[0][a], j = node[1][b], k = node[2][c];
+					const Real expected = grid.inDomainSupportVolume(i, j, k);
+					filling += N * (expected > 0 ? fields.water[grid.index(i, j, k)].volume / expected : 1.0);
+				}
+		return filling;
+	}
+
+	// Linear least-squares fit of the pressures of the points in the 3×3×3 cells around `cell`
+	// (eq. 4.17c), free-surface points left out.
+	static PressureFit fitAroundCell(const GridGeometry& grid, const std::vector<PressureCell>& cells, const std::array<int, 3>& cell)
+	{
+		const Real h = grid.cellSize;
+		PressureCell sum = zeroOf(PressureCell {});
+		for (int dk = -1; dk <= 1; ++dk)
+			for (int dj = -1; dj <= 1; ++dj)
+				for (int di = -1; di <= 1; ++di) {
+					const int delta[3] = { di, dj, dk };
+					int       idx[3];
+					bool      valid = true;
+					for (int d = 0; d < 3; ++d) {
+						idx[d] = grid.wrap(d, cell[d] + delta[d]);
+						valid  = valid && idx[d] >= 0 && idx[d] < grid.nodes[d] - 1;
+					}
+					if (!valid) continue;
+					const PressureCell& c = cells[grid.index(idx[0], idx[1], idx[2])];
+					if (c.volume <= 0) continue;
+					// moments about this cell's centre: x − x_c = (x − x_n) + s, s = the neighbour's centre offset
+					const Vec3 s = h * Vec3(di, dj, dk);
+					sum.volume += c.volume;
+					sum.offset += c.offset + c.volume * s;
+					sum.offsetSquare += c.offsetSquare + s * c.offset.transpose() + c.offset * s.transpose() + c.volume * s * s.transpose();
+					sum.pressure += c.pressure;
+					sum.pressureOffset += c.pressureOffset + c.pressure * s;
+				}
+		const Real mean = sum.pressure / sum.volume; // the edge point asking for the fit makes sum.volume > 0
+		const Vec3 centroid = sum.offset / sum.volume;
+		const Mat3 covariance = sum.offsetSquare - sum.volume * centroid * centroid.transpose();
+		const Vec3 cross      = sum.pressureOffset - sum.pressure * centroid; // Σ V (x − x̄)(p − p̄)
+		// pseudo-inverse: a direction the points do not spread along (a layer one point thick) gets no gradient
+		Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+		eigen.computeDirect(covariance);
+		const Real floor    = 1e-6 * sum.volume * h * h;
+		Vec3       gradient = Vec3::Zero();
+		for (int e = 0; e < 3; ++e)
+			if (eigen.eigenvalues()[e] > floor) {
+				const Vec3 v = eigen.eigenvectors().col(e);
+				gradient += v * (v.dot(cross) / eigen.eigenvalues()[e]);
+			}
+		return PressureFit { mean - gradient.dot(centroid), gradient };
+	}
+
+	template <class Kernel>
+	void dampPressureModes(const GridGeometry& grid, const GridFields& fields, Real relax, Real edgeRelax, Real freeSurfaceThreshold, WaterPointSet& P,
+	                       PressureModeScratch& scratch, ScatterWorkspace& workspace)
+	{
+		const std::size_t count = P.size();
+		std::vector<PressureNode>& nodes = scratch.nodes;
+		nodes.assign(grid.nodeCount(), zeroOf(PressureNode {}));
+		scatter(nodes, workspace.pressure, count, [&](std::size_t p, PressureNode* target) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			const Real V = P.volume[p], pV = V * P.porePressure[p];
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+				target[I].pressureVolume += N * pV;
+				target[I].volume += N * V;
+			});
+		});
+		// Each point's kind. A node is interior when off the wall planes with its full support filled
+		// at the start of the step (1e-3 slack for compression); a point with only interior nodes takes
+		// the nodal mean p̃ (eq. 4.17b), kept in `smoothed` until every point is classified, since the
+		// fits below read the pressures before any relaxation. Other points are edge points (eq.
+		// 4.17c) or, below the filling β, free-surface points that eq. 2.3 resets next: left alone.
+		const Real h = grid.cellSize, fullVolume = (1 - 1e-3) * h * h * h;
+		scratch.kind.resize(count);
+		scratch.smoothed.resize(count);
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			int node[3][Kernel::stencil];
+			stencilNodes(grid, w, node);
+			bool inside = true;
+			Real smoothed = 0;
+			for (int c = 0; c < Kernel::stencil && inside; ++c)
+				for (int b = 0; b < Kernel::stencil && inside; ++b)
+					for (int a = 0; a < Kernel::stencil && inside; ++a) {
+						const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
+						if (N <= 0) continue;
+						const int idx[3] = { node[0][a], node[1][b], node[2][c] };
+						for (int d = 0; d < 3; ++d) inside = inside && (grid.periodic[d] || (idx[d] > grid.wallNode[d] && idx[d] < grid.upperWallNode[d]));
+						const std::size_t I = grid.index(idx[0], idx[1], idx[2]);
+						inside              = inside && fields.water[I].volume >= fullVolume;
+						if (inside) smoothed += N * nodes[I].pressureVolume / nodes[I].volume; // the point's own volume makes nodes[I] non-empty
+					}
+			scratch.smoothed[p] = smoothed;
+			if (inside)
+				scratch.kind[p] = PressureModeScratch::Interior;
+			else if (freeSurfaceThreshold > 0 && waterFilling(grid, fields, P.position[p], P.halfLength[p]) < freeSurfaceThreshold)
+				scratch.kind[p] = PressureModeScratch::FreeSurface;
+			else
+				scratch.kind[p] = PressureModeScratch::Edge;
+		}
+		const Vec3 halfCell = Vec3::Constant(h / 2);
+		if (edgeRelax > 0) {
+			// moments of every point but the free-surface ones, then a fit for each cell holding an edge point
+			scratch.cells.assign(grid.nodeCount(), zeroOf(PressureCell {}));
+			scatter(scratch.cells, workspace.pressureCells, count, [&](std::size_t p, PressureCell* target) {
+				if (scratch.kind[p] == PressureModeScratch::FreeSurface) return;
+				const std::array<int, 3> c = cellOf(grid, P.position[p]);
+				const Vec3 x = P.position[p] - (grid.nodePosition(c[0], c[1], c[2]) + halfCell);
+				const Real V = P.volume[p], pV = V * P.porePressure[p];
+				PressureCell& cell = target[grid.index(c[0], c[1], c[2])];
+				cell.volume += V;
+				cell.offset += V * x;
+				cell.offsetSquare += V * x * x.transpose();
+				cell.pressure += pV;
+				cell.pressureOffset += pV * x;
+			});
+			scratch.fitCells.clear();
+			scratch.cellHasFit.assign(grid.nodeCount(), 0);
+			for (std::size_t p = 0; p < count; ++p) {
+				if (scratch.kind[p] != PressureModeScratch::Edge) continue;
+				const std::array<int, 3> c = cellOf(grid, P.position[p]);
+				const std::size_t        i = grid.index(c[0], c[1], c[2]);
+				if (!scratch.cellHasFit[i]) scratch.cellHasFit[i] = 1, scratch.fitCells.push_back(i);
+			}
+			scratch.fits.resize(grid.nodeCount());
+			const long fitCount = static_cast<long>(scratch.fitCells.size());
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+			for (long f = 0; f < fitCount; ++f) {
+				const std::size_t i = scratch.fitCells[f];
+				const int ci = static_cast<int>(i % grid.nodes[0]), cj = static_cast<int>((i / grid.nodes[0]) % grid.nodes[1]),
+				          ck = static_cast<int>(i / (static_cast<std::size_t>(grid.nodes[0]) * grid.nodes[1]));
+				scratch.fits[i] = fitAroundCell(grid, scratch.cells, { ci, cj, ck });
+			}
+		}
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			if (scratch.kind[p] == PressureModeScratch::Interior) {
+				P.porePressure[p] += relax * (scratch.smoothed[p] - P.porePressure[p]);
+			} else if (scratch.kind[p] == PressureModeScratch::Edge && edgeRelax > 0) {
+				const std::array<int, 3> c   = cellOf(grid, P.position[p]);
+				const PressureFit&       fit = scratch.fits[grid.index(c[0], c[1], c[2])];
+				const Real fitted = fit.value + fit.gradient.dot(P.position[p] - (grid.nodePosition(c[0], c[1], c[2]) + halfCell));
+				P.porePressure[p] += edgeRelax * (fitted - P.porePressure[p]);
+			}
+		}
+	}
+
+	template <class Kernel>
+	void computePressureRates(const GridGeometry& grid, const std::vector<Vec3>& solidVelocity, const std::vector<Vec3>& waterVelocity,
+	                          const WaterPointSet& P, const WaterParameters& water, std::vector<Real>& pressureRate, std::vector<Real>& waterDivergence)
+	{
+		const Real        Kw    = water.bulkModulus;
+		const std::size_t count = P.size();
+		pressureRate.resize(count);
+		waterDivergence.resize(count);
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			Real divS = 0, divW = 0;
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) {
+				divS += solidVelocity[I].dot(dN);
+				divW += waterVelocity[I].dot(dN);
+			});
+			const Real n       = P.porosity[p];
+			pressureRate[p]    = -(Kw / n) * ((1 - n) * divS + n * divW); // eq. 4.16
+			waterDivergence[p] = divW;
+		}
+	}
+
+	void updatePorePressure(const std::vector<Real>& pressureRate, const std::vector<Real>& waterDivergence, WaterPointSet& P, Real dt)
+	{
+		const std::size_t count = P.size();
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			P.porePressure[p] += dt * pressureRate[p];
+			P.volume[p] *= 1 + dt * waterDivergence[p];
+		}
+	}
+
+	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& P,
+	                      const std::vector<PressureModeScratch::Kind>* kinds)
+	{
+		const std::size_t count = P.size();
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			const bool surface = kinds ? (*kinds)[p] == PressureModeScratch::FreeSurface : waterFilling(grid, fields, P.position[p], P.halfLength[p]) < threshold;
+			if (surface) P.porePressure[p] = keepSuction ? std::min<Real>(P.porePressure[p], 0) : 0;
+		}
+	}
+
+#define MPM_INSTANTIATE(K) \
+	template void computePressureRates<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const WaterPointSet&, const WaterParameters&, std::vector<Real>&, std::vector<Real>&); \
+	template void dampPressureModes<K>(const GridGeometry&, const GridFields&, Real, Real, Real, WaterPointSet&, PressureModeScratch&, ScatterWorkspace&);
+
+	MPM_INSTANTIATE(LinearKernel)
+	MPM_INSTANTIATE(GimpKernel)
+#undef MPM_INSTANTIATE
+
+} // namespace stages
+} // namespace mpm

@@ -1,0 +1,50 @@
+// The skeleton at its points (doc/theory.md §4, Step 9, eqs. 4.13–4.15, and §7): deformation
+// gradient, volume, Jaumann elastic trial stress, the return of the plastic models, porosity.
+#include "Stages.hpp"
+
+#include "Stencil.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mpm {
+
+namespace stages {
+	using namespace detail;
+
+	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, SolidSet& set, Real dt)
+	{
+		SolidPointSet&    P      = *set.points;
+		const Real        E      = set.soil.youngModulus, nu = set.soil.poissonRatio;
+		const Real        lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), shear = E / (2 * (1 + nu)), bulk = lambda + 2 * shear / 3;
+		const bool        plastic = set.model != SkeletonModel::LinearElastic, mohrCoulomb = set.model == SkeletonModel::MohrCoulomb;
+		const std::size_t count  = P.size();
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			const Mat3& L    = velocityGradients[p];
+			Mat3        d    = 0.5 * (L + L.transpose());
+			const Mat3  spin = 0.5 * (L - L.transpose());
+			if (volumetricRate) d.diagonal().array() += ((*volumetricRate)[p] - d.trace()) / 3; // B-bar (eq. 4.17)
+			// F and J follow the same (averaged) volumetric rate, so V and n stay consistent with σ′
+			const Mat3 dF = Mat3::Identity() + dt * (d + spin);
+			const Real dJ = dF.determinant();
+			Mat3&      F  = P.deformationGradient[p];
+			F             = dF * F;
+			P.volume[p]   = F.determinant() * P.initialVolume[p]; // eq. 4.14
+			const Mat3 sigma = voigtToMatrix(P.effectiveStress[p]);
+			const Mat3 rate  = lambda * d.trace() * Mat3::Identity() + 2 * shear * d; // D^e : d
+			const Mat3 trial = sigma + dt * (spin * sigma - sigma * spin + rate);     // eq. 4.15 (Jaumann)
+			if (plastic) { // eqs. 7.3–7.5
+				const ReturnResult r = mohrCoulomb ? returnMohrCoulomb(trial, bulk, shear, set.strength, P.plasticShearStrain[p])
+				                                   : returnDruckerPrager(trial, bulk, shear, set.strength, P.plasticShearStrain[p]);
+				P.effectiveStress[p] = matrixToVoigt(r.stress);
+				P.plasticShearStrain[p] += r.plasticShearStrain;
+			} else {
+				P.effectiveStress[p] = matrixToVoigt(trial);
+			}
+			P.porosity[p]        = std::clamp<Real>(1 - (1 - P.porosity[p]) / dJ, 1e-5, 1 - 1e-5); // eq. 1.1
+		}
+	}
+
+} // namespace stages
+} // namespace mpm

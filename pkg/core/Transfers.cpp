@@ -1,0 +1,220 @@
+// Transfers between points and grid (doc/theory.md §4, Steps 0–5 and 8, eq. 4.17): P2G of both
+// phases, nodal porosity and velocities, the MUSL re-map, velocity gradients at the points and the
+// cell averages of point values.
+#include "Stages.hpp"
+
+#include "Stencil.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mpm {
+
+namespace {
+	using namespace detail;
+
+	// Kozeny–Carman permeability ratio κ(n)/κ0 (theory.md eq. 1.7).
+	inline Real kozenyCarmanRatio(Real n, Real n0) { return (n * n * n / ((1 - n) * (1 - n))) / (n0 * n0 * n0 / ((1 - n0) * (1 - n0))); }
+
+	inline void applyConstraint(const std::array<bool, 3>& fixed, Vec3& v)
+	{
+		for (int d = 0; d < 3; ++d)
+			if (fixed[d]) v[d] = 0;
+	}
+
+} // namespace
+
+namespace stages {
+	using namespace detail;
+
+	void resetGrid(GridFields& fields, bool water)
+	{
+		std::fill(fields.solid.begin(), fields.solid.end(), zeroOf(SolidNode {}));
+		if (!water) return;
+		std::fill(fields.water.begin(), fields.water.end(), zeroOf(WaterNode {}));
+		std::fill(fields.waterVelocity.begin(), fields.waterVelocity.end(), Vec3::Zero());
+		std::fill(fields.waterVelocityNew.begin(), fields.waterVelocityNew.end(), Vec3::Zero());
+	}
+
+	template <class Kernel>
+	void mapSolidToGrid(const GridGeometry& grid, const std::vector<SolidSet>& sets, const WaterParameters* water, const Vec3& gravity,
+	                    GridFields& fields, ScatterWorkspace& workspace)
+	{
+		for (const SolidSet& set : sets) {
+			const SolidPointSet& P         = *set.points;
+			const Real           invGrain  = 1 / set.soil.density;
+			const Real           dragScale = water ? water->viscosity / set.soil.intrinsicPermeability : 0; // μw/κ0; no drag when dry
+			const Real           n0        = set.soil.porosity;
+			const bool           kc        = set.kozenyCarman;
+			scatter(fields.solid, workspace.solid, P.size(), [&](std::size_t p, SolidNode* nodes) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				const Real   m = P.mass[p], V = P.volume[p], n = P.porosity[p];
+				const Mat3   sigma   = voigtToMatrix(P.effectiveStress[p]);
+				const Vec3   weight  = m * gravity + P.externalForce[p];
+				const Vec3   mv      = m * P.velocity[p];
+				const Real   Q       = V * n * n * dragScale / (kc ? kozenyCarmanRatio(n, n0) : 1.0);
+				const Real   Vgrain  = m * invGrain;
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					SolidNode& node = nodes[I];
+					node.mass += N * m;
+					node.momentum += N * mv;
+					node.mixtureForce += N * weight - V * (sigma * dN); // eq. 4.2: f = Σ S m b − Σ V σ′·∇S
+					node.volume += N * V;
+					node.solidVolume += N * Vgrain;
+					node.drag += N * Q;
+				});
+			});
+		}
+	}
+
+	void computeNodalPorosity(GridFields& fields)
+	{
+		const std::size_t nodes = fields.solid.size();
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
+		for (std::size_t i = 0; i < nodes; ++i) {
+			const SolidNode& s  = fields.solid[i];
+			fields.porosity[i] = s.volume > 0 ? std::clamp<Real>(1 - s.solidVolume / s.volume, 0, 1) : 1;
+		}
+	}
+
+	template <class Kernel>
+	void mapWaterToGrid(const GridGeometry& grid, std::vector<WaterPointSet*>& sets, const Vec3& gravity, GridFields& fields, ScatterWorkspace& workspace,
+	                    bool pressureForces)
+	{
+		const std::vector<Real>& nodalPorosity = fields.porosity;
+		for (WaterPointSet* set : sets) {
+			WaterPointSet& P = *set;
+			scatter(fields.water, workspace.water, P.size(), [&](std::size_t p, WaterNode* nodes) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				// eq. 4.5: porosity and its gradient at the water point from the nodal field
+				Real n = 0;
+				Vec3 gradN = Vec3::Zero();
+				bool soil  = false;
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					n += N * nodalPorosity[I];
+					gradN += nodalPorosity[I] * dN;
+					soil = soil || (N > 0 && nodalPorosity[I] < 1);
+				});
+				// free water is n = 1 exactly (the sum of the weights is 1 only to round-off)
+				n              = soil ? std::clamp<Real>(n, 1e-5, 1) : 1;
+				P.porosity[p]  = n;
+				const Real m = P.mass[p], V = P.volume[p], pressure = pressureForces ? P.porePressure[p] : 0;
+				const Vec3 weight = m * gravity;
+				const Vec3 mv     = m * P.velocity[p];
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					WaterNode& node = nodes[I];
+					node.mass += N * m;
+					node.momentum += N * mv;
+					node.weight += N * weight;
+					node.porousForce += (V * pressure) * (n * dN + N * gradN); // eq. 4.6
+					node.pressureForce += (V * pressure) * dN;                 // eq. 4.7
+					node.volume += N * V;
+					node.pressureVolume += N * V * pressure;
+				});
+			});
+		}
+	}
+
+	void computeNodalVelocities(GridFields& fields, Real solidMassTolerance, Real waterMassTolerance)
+	{
+		const std::size_t nodes = fields.solid.size();
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
+		for (std::size_t i = 0; i < nodes; ++i) {
+			const SolidNode& s = fields.solid[i];
+			const WaterNode& w = fields.water[i];
+			fields.solidVelocity[i] = s.mass > solidMassTolerance ? Vec3(s.momentum / s.mass) : Vec3::Zero();
+			fields.waterVelocity[i] = w.mass > waterMassTolerance ? Vec3(w.momentum / w.mass) : Vec3::Zero();
+		}
+	}
+
+	template <class Kernel>
+	void remapVelocities(const GridGeometry& grid, const std::vector<const MaterialPointSet*>& sets, Real massTolerance,
+	                     const ConstrainedNodes& constrained, bool solidPhase, std::vector<Vec3>& remapped, ScatterWorkspace& workspace)
+	{
+		// Contact (frictional) wall nodes keep the velocity the contact gave them (eq. 2.6): the
+		// points next to a wall carry the interior's velocity, and remapping them would undo a
+		// stick, so the strain rate at the wall would never see the friction.
+		std::vector<Vec3>& contactVelocity = workspace.contactVelocity;
+		contactVelocity.clear();
+		if (solidPhase)
+			for (std::size_t c : constrained.contact) contactVelocity.push_back(remapped[constrained.node[c]]);
+		// Σ S m v and Σ S m with the weights at the moved points: dividing by the nodal mass of the
+		// step's start instead would make a uniformly moving body strain by ~ |v| Δt/h per step
+		std::vector<MomentumNode>& sums = workspace.remap;
+		sums.assign(remapped.size(), zeroOf(MomentumNode {}));
+		for (const MaterialPointSet* set : sets) {
+			const MaterialPointSet& P = *set;
+			scatter(sums, workspace.momentum, P.size(), [&](std::size_t p, MomentumNode* nodes) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				const Real m  = P.mass[p];
+				const Vec3 mv = m * P.velocity[p];
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+					nodes[I].momentum += N * mv;
+					nodes[I].mass += N * m;
+				});
+			});
+		}
+		const std::size_t count = sums.size();
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t i = 0; i < count; ++i) remapped[i] = sums[i].mass > massTolerance ? Vec3(sums[i].momentum / sums[i].mass) : Vec3::Zero();
+		for (std::size_t c = 0; c < constrained.node.size(); ++c)
+			applyConstraint(solidPhase ? constrained.constraint[c].solid : constrained.constraint[c].water, remapped[constrained.node[c]]);
+		for (std::size_t f = 0; f < contactVelocity.size(); ++f) remapped[constrained.node[constrained.contact[f]]] = contactVelocity[f];
+	}
+
+	template <class Kernel>
+	void computeVelocityGradients(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const MaterialPointSet& P, std::vector<Mat3>& gradients)
+	{
+		const std::size_t count = P.size();
+		gradients.resize(count);
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			Mat3 L = Mat3::Zero();
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) { L.noalias() += gridVelocity[I] * dN.transpose(); });
+			gradients[p] = L;
+		}
+	}
+
+	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& P, std::vector<Real>& values, std::vector<Real>& cellSum,
+	                      std::vector<Real>& cellVolume)
+	{
+		const std::size_t count = P.size(), cells = grid.nodeCount();
+		cellSum.assign(cells, 0);
+		cellVolume.assign(cells, 0);
+		auto cellIndex = [&](std::size_t p) {
+			const std::array<int, 3> c = cellOf(grid, P.position[p]);
+			return grid.index(c[0], c[1], c[2]);
+		};
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			const std::size_t c = cellIndex(p);
+			const Real        v = P.volume[p];
+#pragma omp atomic
+			cellSum[c] += v * values[p];
+#pragma omp atomic
+			cellVolume[c] += v;
+		}
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			const std::size_t c = cellIndex(p);
+			values[p]           = cellSum[c] / cellVolume[c];
+		}
+	}
+
+#define MPM_INSTANTIATE(K) \
+	template void mapSolidToGrid<K>(const GridGeometry&, const std::vector<SolidSet>&, const WaterParameters*, const Vec3&, GridFields&, ScatterWorkspace&); \
+	template void mapWaterToGrid<K>(const GridGeometry&, std::vector<WaterPointSet*>&, const Vec3&, GridFields&, ScatterWorkspace&, bool); \
+	template void remapVelocities<K>(const GridGeometry&, const std::vector<const MaterialPointSet*>&, Real, const ConstrainedNodes&, bool, std::vector<Vec3>&, ScatterWorkspace&); \
+	template void computeVelocityGradients<K>(const GridGeometry&, const std::vector<Vec3>&, const MaterialPointSet&, std::vector<Mat3>&);
+
+	MPM_INSTANTIATE(LinearKernel)
+	MPM_INSTANTIATE(GimpKernel)
+#undef MPM_INSTANTIATE
+
+} // namespace stages
+} // namespace mpm
