@@ -163,6 +163,10 @@ namespace stages {
 				const Real storage    = V * n * invKw / dt; // C/Δt (eq. 8.3), consistent: Σ V S_J S_K n/(Kw Δt)
 				const Vec3 conductance = dt * V * lambda;    // Δt L (eq. 8.6), per axis
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n
+				Vec3 flux[S][S][S]; // Δt V Λ ∇S_K: the column factor of every pair, once per point
+				for (int c = 0; c < S; ++c)
+					for (int b = 0; b < S; ++b)
+						for (int a = 0; a < S; ++a) flux[c][b][a] = conductance.cwiseProduct(dN[c][b][a]);
 				for (int c = 0; c < S; ++c)
 					for (int b = 0; b < S; ++b)
 						for (int a = 0; a < S; ++a) {
@@ -170,10 +174,13 @@ namespace stages {
 							if (Nj == 0 && dN[c][b][a].isZero()) continue;
 							Real* r = rows + static_cast<std::size_t>(system.row[grid.index(node[0][a], node[1][b], node[2][c])]) * PressureSystem::rowStride;
 							r[PressureSystem::rhsSlot] += Nj * (stored - V * divergence);
+							const Real storageJ = storage * Nj;
+							const Vec3 gradJ    = dN[c][b][a];
 							for (int cc = 0; cc < S; ++cc)
-								for (int bb = 0; bb < S; ++bb)
-									for (int aa = 0; aa < S; ++aa)
-										r[offsetSlot(aa - a, bb - b, cc - c)] += storage * Nj * N[cc][bb][aa] + dN[c][b][a].dot(conductance.cwiseProduct(dN[cc][bb][aa]));
+								for (int bb = 0; bb < S; ++bb) {
+									Real* slot = r + offsetSlot(-a, bb - b, cc - c);
+									for (int aa = 0; aa < S; ++aa) slot[aa] += storageJ * N[cc][bb][aa] + gradJ.dot(flux[cc][bb][aa]);
+								}
 						}
 			});
 		}
@@ -241,7 +248,9 @@ namespace stages {
 				if (system.fixed[col]) rhs -= k[o] * system.fixedValue[col];
 				else entries[used++] = Entry { system.unknown[col], k[o] };
 			}
-			std::sort(entries.begin(), entries.begin() + used, [](const Entry& x, const Entry& y) { return x.column < y.column; });
+			// the offsets run in grid order, so the columns come sorted unless a periodic axis wrapped
+			if (!std::is_sorted(entries.begin(), entries.begin() + used, [](const Entry& x, const Entry& y) { return x.column < y.column; }))
+				std::sort(entries.begin(), entries.begin() + used, [](const Entry& x, const Entry& y) { return x.column < y.column; });
 			int merged = 0;
 			for (int e = 0; e < used; ++e) {
 				if (merged > 0 && entries[merged - 1].column == entries[e].column) entries[merged - 1].value += entries[e].value;
