@@ -84,8 +84,6 @@ Outcome runLayer(double slopeAngle, bool wet, double baseFriction)
 	SolverSettings s;
 	s.gravity              = Vec3(gravity * std::sin(slopeAngle), 0, -gravity * std::cos(slopeAngle));
 	s.freeSurfaceThreshold = 0.5; // the layer's surface is the water table: p = 0 there (eq. 2.3)
-	s.scheme               = TimeScheme::Explicit; // validated with the explicit scheme and its relaxations (semi-implicit: not yet)
-	s.pressureModeDamping  = true;
 	TwoPhaseSolver              solver(d, s);
 	std::vector<WaterPointSet*> waters;
 	if (wet)
