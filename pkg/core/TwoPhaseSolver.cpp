@@ -78,9 +78,9 @@ void SolverSettings::validate() const
 	// the relaxations of eqs. 4.17b–c and the suction seal of eq. 2.3b belong to the explicit scheme;
 	// the semi-implicit one is stable without them (theory.md §8.4)
 	if (scheme == TimeScheme::SemiImplicit && pressureModeDamping)
-		throw InvalidParameter("pressureModeDamping = true is a relaxation of the explicit scheme (theory.md eq. 4.17b): it needs scheme = 'explicit'");
+		throw InvalidParameter("pressureModeDamping = True is a relaxation of the explicit scheme (theory.md eq. 4.17b): it needs scheme = 'explicit'");
 	if (scheme == TimeScheme::SemiImplicit && freeSurfaceHoldsSuction)
-		throw InvalidParameter("freeSurfaceHoldsSuction = true belongs to the explicit scheme (theory.md eq. 2.3b): it needs scheme = 'explicit'");
+		throw InvalidParameter("freeSurfaceHoldsSuction = True belongs to the explicit scheme (theory.md eq. 2.3b): it needs scheme = 'explicit'");
 }
 
 TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& settings)

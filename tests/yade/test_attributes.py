@@ -60,6 +60,10 @@ def test_read_only_outputs():
     (w.MpmWaterMat, "bulkModulus", -2.2e9, r"bulkModulus = -2.2e\+09 Pa is outside"),
     (w.MpmTwoPhaseEngine, "flipBlend", 1.5, r"flipBlend = 1.5 is outside the valid range \[0, 1\]"),
     (w.MpmTwoPhaseEngine, "timeStepFactor", 0.0, r"timeStepFactor = 0 is outside"),
+    (w.MpmTwoPhaseEngine, "scheme", "implicit", r"scheme = 'implicit' is not one of: semi-implicit, explicit"),
+    (w.MpmTwoPhaseEngine, "pressureTolerance", 0.0, r"pressureTolerance = 0 Pa is outside the valid range \(0, inf\)"),
+    # the relaxations of the explicit scheme are refused with the (default) semi-implicit one
+    (w.MpmTwoPhaseEngine, "pressureModeDamping", True, r"pressureModeDamping = True .* needs scheme = 'explicit'"),
 ])
 def test_out_of_range_is_refused_with_name_value_and_range(cls, key, value, message):
     with pytest.raises(ValueError, match=message):

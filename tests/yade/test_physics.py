@@ -59,6 +59,23 @@ def test_engine_sub_steps_to_the_critical_time_step(scheme):
     assert engine.subStepsLast == int(np.ceil(1e-3 / (engine.timeStepFactor * engine.criticalTimeStep)))
 
 
+def test_incompressible_water_needs_and_gets_the_semi_implicit_scheme():
+    """bulkModulus = inf (incompressible water): the semi-implicit step (theory.md §8) keeps a
+    column at rest hydrostatic to round-off at its skeleton-wave step; the explicit step, which
+    follows the water's wave, refuses it before any work, naming the attribute and the scheme."""
+    height, cell = 0.5, 0.05
+    soil, water, solid, fluid, engine = column(height, cell, bulk_modulus=float("inf"))
+    O.dt = 2e-3
+    O.run(10, True)
+    p_err = np.abs(fluid.porePressure - 1000 * 9.81 * (height - fluid.pos[:, 2])).max() / (1000 * 9.81 * height)
+    assert p_err < 1e-9 and np.linalg.norm(fluid.vel, axis=1).max() < 1e-9
+    engine.scheme = "explicit"
+    before = (O.iter, engine.stepsDone, fluid.pos.copy())
+    with pytest.raises(RuntimeError, match=r"bulkModulus = inf Pa \(incompressible water\) needs scheme = 'semi-implicit'"):
+        O.run(1, True)
+    assert engine.stepsDone == before[1] and np.array_equal(fluid.pos, before[2])
+
+
 def test_gravity_loading_from_stress_free_start_settles_towards_geostatic():
     """Started stress-free, the column compresses under its buoyant weight: the base effective
     stress approaches −(ρsat − ρw) g H as the drained column consolidates."""
