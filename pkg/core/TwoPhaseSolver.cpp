@@ -354,7 +354,10 @@ void TwoPhaseSolver::updateDomains()
 // accounted in removedWaterMass (theory.md §2.4). Their nodal mass of this step is already spent.
 void TwoPhaseSolver::removeOutflowingWater()
 {
-	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid && !domain_.removeFreeWater) return;
+	bool drainedFace = false;
+	for (int f = 0; f < faceCount; ++f) drainedFace = drainedFace || domain_.boundaries.walls[f].water == WaterWall::Drained;
+	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid && !domain_.removeFreeWater && !drainedFace) return;
+	const Vec3 faceLower = grid_.lower(), faceUpper = grid_.upper();
 	for (WaterPointSet* w : waters_) {
 		const std::size_t n = w->size();
 		removeFlags_.assign(n, 0);
@@ -364,6 +367,12 @@ void TwoPhaseSolver::removeOutflowingWater()
 			for (const WaterSink& sink : domain_.sinks) out = out || sink.contains(w->position[p]);
 			// n = 1 exactly when no node of the point's stencil carries solid (eq. 4.5, this step)
 			out = out || (domain_.removeFreeWater && w->porosity[p] >= 1);
+			// a point whose centre has crossed a drained face has left through it (eq. 2.4)
+			for (int f = 0; f < faceCount && !out; ++f) {
+				if (domain_.boundaries.walls[f].water != WaterWall::Drained || grid_.periodic[f / 2]) continue;
+				const int d = f / 2;
+				out         = f % 2 ? w->position[p][d] > faceUpper[d] : w->position[p][d] < faceLower[d];
+			}
 			if (!out && domain_.removeWaterLeavingGrid)
 				for (int d = 0; d < 3; ++d) { // the widest (GIMP) stencil must fit in the grid
 					const Real u = (w->position[p][d] - grid_.origin[d]) / grid_.cellSize;
