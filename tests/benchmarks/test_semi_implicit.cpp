@@ -183,4 +183,31 @@ TEST(SoilSurface, ConsolidationDrainsThroughTheSoilSurface)
 	}
 }
 
+// Water leaving through a drained face leaves the model as points (theory.md eq. 2.4): a block of
+// free water moving down at 1 m/s through a drained base loses exactly the point layer whose centres
+// have crossed the face in the step, and their mass goes to removedWaterMass (balance exact).
+TEST(Outflow, PointsCrossingADrainedFaceLeaveWithTheirMass)
+{
+	const double    h = 0.1;
+	WaterParameters water;
+	const auto      l     = fixtures::lattice(Vec3::Zero(), Vec3(h, h, 4 * h), h, 2);
+	WaterPointSet   fluid = fixtures::waterLattice(l, 1.0, water.density);
+	for (Vec3& v : fluid.velocity) v = Vec3(0, 0, -1);
+	Domain d;
+	d.upper    = Vec3(h, h, 4 * h);
+	d.cellSize = h;
+	for (int f = 0; f < 4; ++f) d.boundaries.walls[f] = { SolidWall::Free, WaterWall::Impermeable };
+	d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Free, WaterWall::Drained };
+	TwoPhaseSolver solver(d, SolverSettings {});
+	solver.setPoints({}, { &fluid }, water);
+	const double total = std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0), layer = 4 * fluid.mass[0];
+	const double dt    = 0.3 * h; // the lowest layer (centres at h/4) moves 0.3 h: out; the next (3h/4) stays in
+	ASSERT_LE(dt, 0.5 * solver.timeStepLimits().critical);
+	solver.step(dt);
+	EXPECT_EQ(fluid.size(), l.positions.size() - 4);
+	EXPECT_NEAR(solver.removedWaterMass(), layer, 1e-12 * layer);
+	EXPECT_NEAR(std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0) + solver.removedWaterMass(), total, 1e-12 * total);
+	for (const Vec3& x : fluid.position) EXPECT_GE(x.z(), 0); // none left below the face
+}
+
 } // namespace
