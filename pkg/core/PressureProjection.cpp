@@ -36,7 +36,7 @@ namespace stages {
 		const std::size_t nodes = grid.nodeCount();
 		std::vector<int>& row   = system.row;
 		row.assign(nodes, -1);
-		// every node a stencil reaches with a weight or a gradient (the marks race benignly: all write 0)
+		// every node a stencil reaches with a weight or a gradient
 		for (const WaterPointSet* set : sets) {
 			const WaterPointSet& P     = *set;
 			const std::size_t    count = P.size();
@@ -356,28 +356,27 @@ namespace stages {
 				const Real n = P.porosity[p], Vq = P.volume[p] * q;
 				const Vec3 gn = gradN[p];
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
-					nodes[I].water += Vq * (n * dN + N * gn);       // eq. 8.1: ∇(n S_I)
-
+					nodes[I].water += Vq * (n * dN + N * gn); // eq. 8.1: ∇(n S_I)
 				});
 			});
 		}
 		// g^s at the solid points, ∇((1 − n) S_I) (eq. 8.1): the adjoint of the solid's share above
 		for (const SolidSet& set : solids) {
-				const SolidPointSet& P = *set.points;
-				scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
-					Weights1D w[3];
-					weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
-					Real q = 0, n = 0;
-					Vec3 gn = Vec3::Zero();
-					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
-						q += N * pressure[I];
-						n += N * fields.porosity[I];
-						gn += fields.porosity[I] * dN;
-					});
-					const Real Vq = P.volume[p] * q;
-					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) { nodes[I].solid += Vq * ((1 - n) * dN - N * gn); });
+			const SolidPointSet& P = *set.points;
+			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				Real q = 0, n = 0;
+				Vec3 gn = Vec3::Zero();
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					q += N * pressure[I];
+					n += N * fields.porosity[I];
+					gn += fields.porosity[I] * dN;
 				});
-			}
+				const Real Vq = P.volume[p] * q;
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) { nodes[I].solid += Vq * ((1 - n) * dN - N * gn); });
+			});
+		}
 		// the boundary terms of drained faces with p̄ ≠ 0 (eq. 2.2): −∮ N n p̄ n̂ on the water, the
 		// rest of −∮ N p̄ n̂ on the solid. They belong with the pressure forces: in the predictor they
 		// would meet no pressure gradient and throw the face nodes' water far off before the solve.
