@@ -103,16 +103,30 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 	water.validate();
 	if (!std::isfinite(water.bulkModulus) && settings_.scheme == TimeScheme::Explicit && !waters.empty())
 		throw InvalidParameter("bulkModulus = inf Pa (incompressible water) needs scheme = 'semi-implicit': the explicit step follows the water's wave");
+	// GIMP (theory.md eq. 3.2) holds for domains no wider than a cell, l_p ≤ h/2
+	auto requireDomainsInACell = [&](const MaterialPointSet& P, const std::string& name) {
+		if (settings_.shapeFunction == ShapeFunction::Linear) return; // the hat ignores the domains
+		const Real limit = 0.5 * grid_.cellSize;
+		for (std::size_t p = 0; p < P.size(); ++p)
+			if (P.halfLength[p].maxCoeff() > limit * (1 + 1e-12)) {
+				std::ostringstream range;
+				range << "[0, cellSize/2 = " << limit << " m] in every component (a GIMP domain must fit in one cell)";
+				throwOutOfRange(name + ".halfLength[" + std::to_string(p) + "]", P.halfLength[p].maxCoeff(), "m", range.str());
+			}
+	};
 	Real minSolid = inf, minWater = inf;
 	for (std::size_t s = 0; s < solids.size(); ++s) {
 		solids[s].soil.validate();
 		if (solids[s].model != SkeletonModel::LinearElastic) solids[s].strength.validate();
 		if (solids[s].name.empty()) solids[s].name = "solid set " + std::to_string(s);
 		solids[s].points->validate(solids[s].name);
+		requireDomainsInACell(*solids[s].points, solids[s].name);
 		minSolid = smallestMass(*solids[s].points, minSolid);
 	}
 	for (std::size_t w = 0; w < waters.size(); ++w) {
-		waters[w]->validate(w < waterNames.size() ? waterNames[w] : "water set " + std::to_string(w));
+		const std::string name = w < waterNames.size() ? waterNames[w] : "water set " + std::to_string(w);
+		waters[w]->validate(name);
+		requireDomainsInACell(*waters[w], name);
 		minWater = smallestMass(*waters[w], minWater);
 	}
 	solids_ = std::move(solids);

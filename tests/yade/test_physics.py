@@ -76,6 +76,20 @@ def test_incompressible_water_needs_and_gets_the_semi_implicit_scheme():
     assert engine.stepsDone == before[1] and np.array_equal(fluid.pos, before[2])
 
 
+def test_gimp_domain_wider_than_a_cell_is_refused_before_any_work():
+    """GIMP (theory.md eq. 3.2) holds for l_p ≤ h/2: a wider domain is refused at the first step,
+    naming the body, the attribute, the point, the value and the range; nothing moves."""
+    soil, water, solid, fluid, engine = column(0.5, 0.05)
+    lengths = solid.halfLength
+    lengths[17] = (0.0125, 0.03, 0.0125)
+    solid.halfLength = lengths
+    O.dt = 1e-3
+    before = solid.pos.copy()
+    with pytest.raises(RuntimeError, match=r"O\.bodies\[0\]\.shape\.halfLength\[17\] = 0\.03 m is outside the valid range \[0, cellSize/2 = 0\.025 m\]"):
+        O.run(1, True)
+    assert engine.stepsDone == 0 and np.array_equal(solid.pos, before)
+
+
 def test_gravity_loading_from_stress_free_start_settles_towards_geostatic():
     """Started stress-free, the column compresses under its buoyant weight: the base effective
     stress approaches −(ρsat − ρw) g H as the drained column consolidates."""
