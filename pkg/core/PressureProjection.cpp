@@ -393,9 +393,7 @@ namespace stages {
 			const bool hasS = s.mass > solidMassTolerance, hasW = wn.mass > waterMassTolerance;
 			ds = dw = Vec3::Zero();
 			if (hasS && hasW) {
-				const Real ms = s.mass, mw = wn.mass, QDt = s.drag * dt, D = ms * mw + QDt * (ms + mw);
-				ds = (dt / D) * ((mw + QDt) * g.solid + QDt * g.water);
-				dw = (dt / D) * (QDt * g.solid + (ms + QDt) * g.water);
+				dragCoupledIncrements(s.mass, wn.mass, s.drag * dt, g.solid, g.water, dt, ds, dw);
 			} else if (hasW) {
 				dw = (dt / wn.mass) * g.water;
 			} else if (hasS) {

@@ -114,6 +114,15 @@ namespace stages {
 	                       const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, const ConstrainedNodes& constrained,
 	                       const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system);
 
+	// Velocity increments of one node for pressure forces g^s, g^w (eq. 8.8): the nodal 2×2 system
+	// [ms + QΔt, −QΔt; −QΔt, mw + QΔt] (δs, δw) = Δt (g^s, g^w), in closed form.
+	inline void dragCoupledIncrements(Real ms, Real mw, Real dragTimesDt, const Vec3& gs, const Vec3& gw, Real dt, Vec3& ds, Vec3& dw)
+	{
+		const Real D = ms * mw + dragTimesDt * (ms + mw);
+		ds           = (dt / D) * ((mw + dragTimesDt) * gs + dragTimesDt * gw);
+		dw           = (dt / D) * (dragTimesDt * gs + (ms + dragTimesDt) * gw);
+	}
+
 	// Mobility λ per unit volume of eq. 8.5 [m³ kg⁻¹]: [1−n, n] M⁻¹ [1−n, n]ᵀ of the nodal 2×2
 	// system per unit volume, with partial densities (1−n)ρs, nρw and drag Q̂Δt (Q̂ = n²μw/κ).
 	// Free water (n = 1): 1/ρw.

@@ -96,6 +96,7 @@ public:
 	const GridGeometry&                                 grid() const { return grid_; }
 	// The last semi-implicit pressure solve (zeros before the first one or with the explicit scheme).
 	const PressureSolveReport&                          lastPressureSolve() const { return lastPressureSolve_; }
+	const PressureSystem&                               pressureSystem() const { return pressureSystem_; } // the last step's (tests, diagnostics)
 	const GridFields&                                   fields() const { return fields_; }
 	const SolverSettings&                               settings() const { return settings_; }
 
