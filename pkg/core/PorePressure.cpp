@@ -179,11 +179,11 @@ namespace stages {
 
 	template <class Kernel>
 	void computePressureRates(const GridGeometry& grid, const std::vector<Vec3>& solidVelocity, const std::vector<Vec3>& waterVelocity,
-	                          const WaterPointSet& P, const WaterParameters& water, std::vector<Real>& pressureRate, std::vector<Real>& waterDivergence)
+	                          const WaterPointSet& P, const WaterParameters& water, std::vector<Real>* pressureRate, std::vector<Real>& waterDivergence)
 	{
 		const Real        Kw    = water.bulkModulus;
 		const std::size_t count = P.size();
-		pressureRate.resize(count);
+		if (pressureRate) pressureRate->resize(count);
 		waterDivergence.resize(count);
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
@@ -194,20 +194,24 @@ namespace stages {
 				divS += solidVelocity[I].dot(dN);
 				divW += waterVelocity[I].dot(dN);
 			});
-			const Real n       = P.porosity[p];
-			pressureRate[p]    = -(Kw / n) * ((1 - n) * divS + n * divW); // eq. 4.16
+			const Real n = P.porosity[p];
+			if (pressureRate) (*pressureRate)[p] = -(Kw / n) * ((1 - n) * divS + n * divW); // eq. 4.16
 			waterDivergence[p] = divW;
 		}
 	}
 
-	void updatePorePressure(const std::vector<Real>& pressureRate, const std::vector<Real>& waterDivergence, WaterPointSet& P, Real dt)
+	void updatePorePressure(const std::vector<Real>& pressureRate, WaterPointSet& P, Real dt)
 	{
 		const std::size_t count = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t p = 0; p < count; ++p) {
-			P.porePressure[p] += dt * pressureRate[p];
-			P.volume[p] *= 1 + dt * waterDivergence[p];
-		}
+		for (std::size_t p = 0; p < count; ++p) P.porePressure[p] += dt * pressureRate[p];
+	}
+
+	void updateWaterVolume(const std::vector<Real>& waterDivergence, WaterPointSet& P, Real dt)
+	{
+		const std::size_t count = P.size();
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) P.volume[p] *= 1 + dt * waterDivergence[p];
 	}
 
 	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& P,
@@ -222,7 +226,7 @@ namespace stages {
 	}
 
 #define MPM_INSTANTIATE(K) \
-	template void computePressureRates<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const WaterPointSet&, const WaterParameters&, std::vector<Real>&, std::vector<Real>&); \
+	template void computePressureRates<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const WaterPointSet&, const WaterParameters&, std::vector<Real>*, std::vector<Real>&); \
 	template void dampPressureModes<K>(const GridGeometry&, const GridFields&, Real, Real, Real, WaterPointSet&, PressureModeScratch&, ScatterWorkspace&);
 
 	MPM_INSTANTIATE(LinearKernel)

@@ -163,15 +163,18 @@ namespace stages {
 	// point) replaces tr d when given (cell-averaged volumetric strain rate, B-bar).
 	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, SolidSet& set, Real dt);
 
-	// Step 10 (theory.md eq. 4.16): pore-pressure rate ṗ = −(Kw/n)[(1−n)∇·v^s + n∇·v^w] at every
-	// water point, from the divergences of both grid velocities (nodes without solid have v̂^s = 0).
+	// Step 10 (theory.md eq. 4.16): ∇·v^w at every water point and, when `pressureRate` is given
+	// (explicit scheme), the pore-pressure rate ṗ = −(Kw/n)[(1−n)∇·v^s + n∇·v^w], from the
+	// divergences of both grid velocities (nodes without solid have v̂^s = 0).
 	template <class Kernel>
 	void computePressureRates(const GridGeometry& grid, const std::vector<Vec3>& solidVelocity, const std::vector<Vec3>& waterVelocity,
-	                          const WaterPointSet& points, const WaterParameters& water, std::vector<Real>& pressureRate,
+	                          const WaterPointSet& points, const WaterParameters& water, std::vector<Real>* pressureRate,
 	                          std::vector<Real>& waterDivergence);
 
-	// Advance pore pressure and water volume with the (possibly cell-averaged) rates.
-	void updatePorePressure(const std::vector<Real>& pressureRate, const std::vector<Real>& waterDivergence, WaterPointSet& points, Real dt);
+	// Advance the pore pressure with the (possibly cell-averaged) rate (explicit scheme).
+	void updatePorePressure(const std::vector<Real>& pressureRate, WaterPointSet& points, Real dt);
+	// Advance the water points' volume with the (possibly cell-averaged) divergence: V ← V (1 + Δt ∇·v^w).
+	void updateWaterVolume(const std::vector<Real>& waterDivergence, WaterPointSet& points, Real dt);
 
 	// Free surface (theory.md eq. 2.3): p = 0 on water points whose filling Σ S_I V^w_I/V^full_I
 	// (nodal water-point volume over the node's full in-domain support volume) is below `threshold`;

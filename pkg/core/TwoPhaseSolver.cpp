@@ -144,7 +144,7 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 	throwIfOutsideGrid();
 }
 
-TimeStepLimits TwoPhaseSolver::timeStepLimits() const
+TimeStepLimits TwoPhaseSolver::timeStepLimits(Real horizon) const
 {
 	const bool hasWater = !waters_.empty(), semiImplicit = settings_.scheme == TimeScheme::SemiImplicit;
 	const Real rhoW = water_.density, Kw = water_.bulkModulus;
@@ -175,7 +175,14 @@ TimeStepLimits TwoPhaseSolver::timeStepLimits() const
 	for (const WaterPointSet* set : waters_)
 		for (const Vec3& v : set->velocity) pointSpeed = std::max(pointSpeed, v.norm());
 	TimeStepLimits limits;
-	limits.wave     = speed + pointSpeed > 0 ? grid_.cellSize / (speed + pointSpeed) : inf;
+	// semi-implicit water with no skeleton has no wave in the limit, and at rest it would get any
+	// step: the points' speed as gravity may raise it over the horizon, and at most √(h/|g|), in
+	// which a point starting at rest falls h/2 (eq. 8.10)
+	const Real g         = settings_.gravity.norm();
+	const bool waterOnly = hasWater && semiImplicit && solids_.empty();
+	if (waterOnly) pointSpeed += g * horizon;
+	limits.wave = speed + pointSpeed > 0 ? grid_.cellSize / (speed + pointSpeed) : inf;
+	if (waterOnly && g > 0) limits.wave = std::min(limits.wave, std::sqrt(grid_.cellSize / g));
 	limits.drag     = dragLimit;
 	limits.critical = std::min(limits.wave, limits.drag);
 	return limits;
@@ -184,7 +191,7 @@ TimeStepLimits TwoPhaseSolver::timeStepLimits() const
 long TwoPhaseSolver::advance(Real dt)
 {
 	requireOpenRange("dt", dt, 0, inf, "s");
-	lastLimits_        = timeStepLimits();
+	lastLimits_        = timeStepLimits(dt);
 	const Real allowed = settings_.timeStepFactor * lastLimits_.critical;
 	const long substeps = std::isfinite(allowed) ? std::max<long>(1, static_cast<long>(std::ceil(dt / allowed * (1 - 1e-12)))) : 1;
 	for (long i = 0; i < substeps; ++i) step(dt / substeps);
@@ -249,9 +256,10 @@ void TwoPhaseSolver::integrateMomentum(Real dt, bool wet, bool semiImplicit)
 	computeNodalVelocities(fields_, solidMassTolerance_, waterMassTolerance_);
 	const bool holdSuction = wet && settings_.freeSurfaceHoldsSuction;
 	if (holdSuction) markSuctionHoldingNodes(grid_, fields_, settings_.freeSurfaceThreshold, solidMassTolerance_, waterMassTolerance_, suctionHolding_);
-	// the semi-implicit step applies the wall friction once, after the corrector
-	integrateNodalMomentum(fields_, constrained_, dt, settings_.drag, solidMassTolerance_, waterMassTolerance_, holdSuction ? &suctionHolding_ : nullptr,
-	                       !semiImplicit, &heldSolid_);
+	// the semi-implicit step takes the drag implicitly (its corrector is the implicit 2×2 system, and
+	// its time step knows no drag limit) and applies the wall friction once, after the corrector
+	integrateNodalMomentum(fields_, constrained_, dt, semiImplicit ? DragScheme::SemiImplicit : settings_.drag, solidMassTolerance_, waterMassTolerance_,
+	                       holdSuction ? &suctionHolding_ : nullptr, !semiImplicit, &heldSolid_);
 }
 
 template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
@@ -333,14 +341,15 @@ template <class Kernel> void TwoPhaseSolver::updateWater(Real dt, bool semiImpli
 	StageTimer t(stageSeconds_, Stage::UpdatePorePressure);
 	const bool average = settings_.cellAveragedVolumetricRate;
 	for (WaterPointSet* w : waters_) {
-		computePressureRates<Kernel>(grid_, fields_.solidVelocityNew, fields_.waterVelocityNew, *w, water_, pressureRate_, waterDivergence_);
+		// semi-implicit: the pressure was advanced by the projection (eq. 8.8); only the volume moves here
+		computePressureRates<Kernel>(grid_, fields_.solidVelocityNew, fields_.waterVelocityNew, *w, water_, semiImplicit ? nullptr : &pressureRate_,
+		                             waterDivergence_);
 		if (average) {
 			if (!semiImplicit) averageOverCells(grid_, *w, pressureRate_, cellSum_, cellVolume_);
 			averageOverCells(grid_, *w, waterDivergence_, cellSum_, cellVolume_);
 		}
-		// semi-implicit: the pressure was advanced by the projection (eq. 8.8); only the volume moves here
-		if (semiImplicit) std::fill(pressureRate_.begin(), pressureRate_.end(), 0.0);
-		updatePorePressure(pressureRate_, waterDivergence_, *w, dt);
+		if (!semiImplicit) updatePorePressure(pressureRate_, *w, dt);
+		updateWaterVolume(waterDivergence_, *w, dt);
 		// semi-implicit: the points carry the interpolated solution, which holds the faces and the
 		// free surface at their nodes (theory.md §8.5); explicit: relaxations and resets (eqs. 4.17b–c, 2.1, 2.3)
 		if (semiImplicit) continue;

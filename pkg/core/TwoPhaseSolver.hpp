@@ -46,7 +46,7 @@ struct Domain {
 
 // Time-step limits of the current state (theory.md §5, eqs. 5.1–5.2), before the safety factor.
 struct TimeStepLimits {
-	Real wave;     // h / (fastest wave + fastest point) [s]; semi-implicit: the skeleton wave (eq. 8.10)
+	Real wave;     // h / (fastest wave + fastest point) [s]; semi-implicit: the skeleton wave (water alone: at most √(h/|g|), eq. 8.10)
 	Real drag;     // 2/λ of the explicit drag; infinity with semi-implicit drag or scheme [s]
 	Real critical; // min of the above [s]
 };
@@ -77,7 +77,10 @@ public:
 	void setPoints(std::vector<SolidSet> solids, std::vector<WaterPointSet*> waters, const WaterParameters& water,
 	               const std::vector<std::string>& waterNames = {});
 
-	TimeStepLimits timeStepLimits() const;
+	// `horizon` [s]: the time the limits must hold over (advance's dt). The semi-implicit step of
+	// water with no skeleton is bounded by no wave, so there the points' speed is taken as they may
+	// reach it under gravity by then, max |v_p| + |g| horizon (eq. 8.10).
+	TimeStepLimits timeStepLimits(Real horizon = 0) const;
 	// One explicit step of size dt (no sub-stepping). Throws InstabilityError naming the step,
 	// the point and the quantity if the state stops being finite or a point leaves the grid.
 	void step(Real dt);

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 namespace {
 
@@ -207,6 +208,72 @@ TEST(Outflow, PointsCrossingADrainedFaceLeaveWithTheirMass)
 	EXPECT_NEAR(solver.removedWaterMass(), layer, 1e-12 * layer);
 	EXPECT_NEAR(std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0) + solver.removedWaterMass(), total, 1e-12 * total);
 	for (const Vec3& x : fluid.position) EXPECT_GE(x.z(), 0); // none left below the face
+}
+
+// Free water released from rest (a dam break, real water): with no skeleton and no speed yet, only
+// gravity bounds the step (eq. 8.10): the fall limit √(h/|g|) and the speed |g| O.dt the points may
+// reach within one O.dt. One O.dt of 0.1 s is split by it and the column collapses without a point
+// crossing more than a cell in a step (the solver would stop); water mass exact, and the front has
+// moved, no faster than Ritter's front speed 2√(gH).
+TEST(SemiImplicitFreeWater, DamBreakFromRestTakesTheFallLimit)
+{
+	const double    h = 0.02, a = 0.1, H = 0.2;
+	WaterParameters water;
+	const auto      l     = fixtures::lattice(Vec3::Zero(), Vec3(a, 3 * h, H), h, 2);
+	WaterPointSet   fluid = fixtures::waterLattice(l, 1.0, water.density);
+	for (std::size_t p = 0; p < fluid.size(); ++p) fluid.porePressure[p] = water.density * g0 * (H - fluid.position[p].z());
+	Domain d;
+	d.upper               = Vec3(0.6, 3 * h, 0.3);
+	d.cellSize            = h;
+	d.boundaries.periodic = { false, true, false };
+	for (Face f : { Face::XMin, Face::XMax, Face::ZMin }) d.boundaries.walls[static_cast<int>(f)] = { SolidWall::Free, WaterWall::Impermeable };
+	SolverSettings s;
+	s.gravity = Vec3(0, 0, -g0);
+	TwoPhaseSolver solver(d, s);
+	solver.setPoints({}, { &fluid }, water);
+	EXPECT_NEAR(solver.timeStepLimits().critical, std::sqrt(h / g0), 1e-15);
+	const double mass = std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0);
+	const long   steps = solver.advance(0.1);
+	double       front = 0;
+	for (const Vec3& x : fluid.position) front = std::max(front, x.x());
+	std::printf("dam break: 0.1 s in %ld sub-steps, front at x/a = %.2f\n", steps, front / a);
+	EXPECT_EQ(steps, static_cast<long>(std::ceil(0.1 / (0.5 * h / (g0 * 0.1)) * (1 - 1e-12))));
+	EXPECT_NEAR(std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0), mass, 1e-12 * mass);
+	EXPECT_GT(front, a + h);                              // the column has collapsed forward
+	EXPECT_LT(front, a + 2 * std::sqrt(g0 * H) * 0.1 + h); // no faster than Ritter's front
+}
+
+// The semi-implicit step always takes the drag implicitly (its corrector is the implicit 2×2 system
+// and its step knows no drag limit): `drag = Explicit` must not change it. At k = 1e-7 m/s the
+// explicit drag's own limit 2/λ is ~1e-7 of the step taken here: had the predictor used it, the
+// loaded column would blow up instead of matching the implicit run to the last bit.
+TEST(SemiImplicitExtremes, DragSettingDoesNotReachTheSemiImplicitStep)
+{
+	auto run = [](DragScheme drag) {
+		const double    h = 0.05, H = 0.5;
+		SoilParameters  soil;
+		WaterParameters water;
+		soil.intrinsicPermeability = 1e-7 * water.viscosity / (water.density * g0);
+		const auto    l            = fixtures::lattice(Vec3::Zero(), Vec3(h, h, H), h, 2);
+		SolidPointSet solid        = fixtures::solidLattice(l, soil.porosity, soil.density);
+		WaterPointSet fluid        = fixtures::waterLattice(l, soil.porosity, water.density);
+		fixtures::setGeostatic(solid, fluid, soil, water, g0, H);
+		for (std::size_t p = 0; p < solid.size(); ++p)
+			if (solid.position[p].z() > H - l.spacing) solid.externalForce[p] = Vec3(0, 0, -10e3 * l.spacing * l.spacing);
+		SolverSettings s;
+		s.gravity = Vec3(0, 0, -g0);
+		s.drag    = drag;
+		TwoPhaseSolver solver(fixtures::columnDomain(Vec3(h, h, H), h), s);
+		solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+		EXPECT_EQ(solver.timeStepLimits().drag, std::numeric_limits<double>::infinity());
+		const double dt = 0.5 * solver.timeStepLimits().critical;
+		for (int i = 0; i < 50; ++i) solver.step(dt);
+		return std::make_pair(solid, fluid);
+	};
+	const auto implicitDrag = run(DragScheme::SemiImplicit), explicitDrag = run(DragScheme::Explicit);
+	EXPECT_TRUE(implicitDrag.first.position == explicitDrag.first.position);
+	EXPECT_TRUE(implicitDrag.second.porePressure == explicitDrag.second.porePressure);
+	EXPECT_GT(implicitDrag.second.porePressure.front(), 0); // something happened: the load is carried
 }
 
 } // namespace
