@@ -14,7 +14,7 @@ namespace stages {
 
 	template <class Kernel>
 	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
-	                           MaterialPointSet& points, Real dt, Real flipBlend)
+	                           const std::vector<Real>& retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt, Real flipBlend)
 	{
 		const std::size_t count   = points.size();
 		long              invalid = -1;
@@ -22,12 +22,17 @@ namespace stages {
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, points.position[p], points.halfLength[p], w);
-			Vec3 vNew = Vec3::Zero(), dv = Vec3::Zero();
+			Vec3 vNew = Vec3::Zero(), vOld = Vec3::Zero(), gained = Vec3::Zero();
+			Real kept = 0;
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 				vNew += N * gridVelocityNew[I];
-				dv += N * (gridVelocityNew[I] - gridVelocity[I]);
+				vOld += N * gridVelocity[I];
+				kept += N * retention[I];
+				if (received) gained += N * (*received)[I];
 			});
-			const Vec3 v        = flipBlend * (points.velocity[p] + dv) + (1 - flipBlend) * vNew; // eq. 4.11
+			// eq. 4.11 written as v̄ + α(v_p − Σ S v^n_I), the unresolved part damped by eq. 4.11b and
+			// the momentum the other phase's points lost to drag received (eq. 4.11c)
+			const Vec3 v        = vNew + (flipBlend * kept) * (points.velocity[p] - vOld) + gained;
 			points.velocity[p]  = v;
 			points.position[p] += dt * vNew;
 			wrapPosition(grid, points.position[p]);
@@ -35,6 +40,33 @@ namespace stages {
 				invalid = std::max<long>(invalid, static_cast<long>(count - p)); // smallest index wins
 		}
 		return invalid < 0 ? -1 : static_cast<long>(count) - invalid;
+	}
+
+	void dragRetention(const GridFields& fields, bool solidPhase, Real solidMassTolerance, Real waterMassTolerance, Real dt, std::vector<Real>& retention)
+	{
+		const std::size_t count = fields.solid.size();
+		retention.resize(count);
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t I = 0; I < count; ++I) {
+			const Real ms = fields.solid[I].mass, mw = fields.water[I].mass;
+			retention[I]  = ms > solidMassTolerance && mw > waterMassTolerance ? 1 / (1 + dt * fields.solid[I].drag / (solidPhase ? ms : mw)) : 1;
+		}
+	}
+
+	template <class Kernel>
+	void scatterDragLoss(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Real>& retention, const MaterialPointSet& points,
+	                     Real flipBlend, std::vector<Vec3>& lost, std::vector<std::vector<Vec3>>& buffers)
+	{
+		scatter(lost, buffers, points.size(), [&](std::size_t p, Vec3* nodes) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, points.position[p], points.halfLength[p], w);
+			Vec3 vOld = Vec3::Zero();
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) { vOld += N * gridVelocity[I]; });
+			const Vec3 unresolved = flipBlend * points.mass[p] * (points.velocity[p] - vOld);
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+				if (retention[I] < 1) nodes[I] += (N * (1 - retention[I])) * unresolved;
+			});
+		});
 	}
 
 	void updateDomainsCpGimp(SolidPointSet& P, Real cellSize)
@@ -61,7 +93,8 @@ namespace stages {
 	}
 
 #define MPM_INSTANTIATE(K) \
-	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, MaterialPointSet&, Real, Real); \
+	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const std::vector<Real>&, const std::vector<Vec3>*, MaterialPointSet&, Real, Real); \
+	template void scatterDragLoss<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Real>&, const MaterialPointSet&, Real, std::vector<Vec3>&, std::vector<std::vector<Vec3>>&); \
 	template long firstPointOutsideGrid<K>(const GridGeometry&, const MaterialPointSet&);
 
 	MPM_INSTANTIATE(LinearKernel)

@@ -101,8 +101,8 @@ namespace stages {
 					vwNew = vw + (dt / mw) * (fw - Q * (vw - vs));
 				}
 				vsNew = vs + (dt / ms) * fm + (mw / ms) * (vw - vwNew); // mixture momentum
-			} else if (hasW) { // free water: no solid, no drag
-				vwNew = vw + (dt / w.mass) * fw;
+			} else if (hasW) { // no solid at the node: the water carries the whole mixture force (no drag)
+				vwNew = vw + (dt / w.mass) * fm;
 			} else if (hasS) { // solid without water
 				vsNew = vs + (dt / s.mass) * fm;
 			}

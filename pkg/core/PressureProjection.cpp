@@ -395,7 +395,7 @@ namespace stages {
 			if (hasS && hasW) {
 				dragCoupledIncrements(s.mass, wn.mass, s.drag * dt, g.solid, g.water, dt, ds, dw);
 			} else if (hasW) {
-				dw = (dt / wn.mass) * g.water;
+				dw = (dt / wn.mass) * (g.water + g.solid); // no solid here: the whole pressure force on the water, as below
 			} else if (hasS) {
 				ds = (dt / s.mass) * (g.solid + g.water); // the whole pressure force on the mixture
 			}

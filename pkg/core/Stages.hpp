@@ -119,13 +119,28 @@ namespace stages {
 	void applyWallFriction(GridFields& fields, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
 	                       Real solidMassTolerance, Real waterMassTolerance);
 
-	// Step 7 (theory.md eq. 4.11): G2P with FLIP/PIC blend α; positions move with the new grid
-	// velocity. Returns the index of the first runaway point, or -1: one whose velocity is not
-	// finite or whose displacement in this step exceeds the cell size (a CFL violation that no
-	// stable explicit step produces).
+	// Step 7 (theory.md eqs. 4.11–4.11c): G2P with FLIP/PIC blend α; the part of the point velocity
+	// the grid does not carry is damped by the drag at the point, `retention` per node
+	// (dragRetention, interpolated), and the velocity `received` per node (null: none) is added;
+	// positions move with the new grid velocity. Returns the index of the first runaway point, or -1:
+	// one whose velocity is not finite or whose displacement in this step exceeds the cell size (a
+	// CFL violation that no stable explicit step produces).
 	template <class Kernel>
 	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
-	                           MaterialPointSet& points, Real dt, Real flipBlend);
+	                           const std::vector<Real>& retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt,
+	                           Real flipBlend);
+
+	// theory.md eq. 4.11b: per node, the factor 1/(1 + Δt Q_I/m_I) by which the implicit drag Q_I
+	// damps, within one step, a velocity of this phase's points that the other phase does not share
+	// (m_I the phase's nodal mass); 1 where the node lacks either phase (no drag acts there).
+	void dragRetention(const GridFields& fields, bool solidPhase, Real solidMassTolerance, Real waterMassTolerance, Real dt, std::vector<Real>& retention);
+
+	// theory.md eq. 4.11c: adds to `lost` the momentum α (1 − r_I) S_Ip m_p (v_p − Σ S v^n_I) that
+	// eq. 4.11b takes from each point of one phase at each node, before the points move; it goes to
+	// the other phase at that node, so the drag stays internal and the total momentum is kept.
+	template <class Kernel>
+	void scatterDragLoss(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Real>& retention, const MaterialPointSet& points,
+	                     Real flipBlend, std::vector<Vec3>& lost, std::vector<std::vector<Vec3>>& buffers);
 
 	// Step 8 (theory.md eq. 4.12): MUSL re-map of the point momenta of one phase to the grid,
 	// written to `remapped` (v̂_I), then the wall constraints of that phase. Momentum and mass are

@@ -24,6 +24,7 @@ struct SolverSettings {
 	Real          pressureTolerance          = 1e-3;  // δp [Pa] > 0: the semi-implicit pressure solve stops at the residual of a pressure error δp at a typical node (§8.7)
 	Real          freeSurfaceThreshold       = 0;    // β [-], 0 ≤ β < 1: p = 0 on points filled below β (eq. 2.3); 0: off
 	bool          freeSurfaceHoldsSuction    = false; // eq. 2.3b (explicit scheme only): the surface keeps suction (p < 0) and releases only p > 0
+	long          maxSubSteps                = 100000; // N_max [-] ≥ 1: advance(dt) refuses a dt that needs more sub-steps than this (a mistyped step, not a run)
 	void          validate() const;
 };
 
@@ -87,6 +88,10 @@ public:
 	// Advance by dt in equal sub-steps no larger than timeStepFactor × critical; returns their number.
 	// The limits it used are kept in lastTimeStepLimits().
 	long                  advance(Real dt);
+	// The sub-steps advance(dt) would take now (the critical step of the current state, theory.md §5,
+	// eq. 8.10), without advancing anything.
+	long                  subStepsFor(Real dt) const;
+	long                  subStepsFor(Real dt, TimeStepLimits& limits) const;
 	const TimeStepLimits& lastTimeStepLimits() const { return lastLimits_; }
 
 	long                                                stepCount() const { return steps_; }
@@ -137,6 +142,9 @@ private:
 	void                          injectInflowingWater();
 	std::vector<long>             inflowNearest_;
 	std::vector<Real>             inflowDepth_;
+	std::vector<Real>             solidRetention_, waterRetention_; // eq. 4.11b per node [-]
+	std::vector<Vec3>             solidDragLoss_, waterDragLoss_;   // eq. 4.11c per node: momentum lost, then velocity received [m s⁻¹]
+	std::vector<std::vector<Vec3>> lossBuffers_;
 	TimeStepLimits                lastLimits_ {};
 	void                          removeOutflowingWater();
 	std::vector<char>             removeFlags_;

@@ -9,6 +9,7 @@
 #include "../core/Errors.hpp"
 
 #include <array>
+#include <sstream>
 #include <limits>
 
 namespace yade_mpm {
@@ -100,6 +101,7 @@ mpm::SolverSettings MpmTwoPhaseEngine::settings() const
 	s.pressureModeDamping        = pressureModeDamping;
 	s.freeSurfaceThreshold       = freeSurfaceThreshold;
 	s.freeSurfaceHoldsSuction    = freeSurfaceHoldsSuction;
+	s.maxSubSteps                = maxSubSteps;
 	s.validate();
 	return s;
 }
@@ -140,6 +142,15 @@ void MpmTwoPhaseEngine::action()
 		}
 	}
 	solver_->setPoints(std::move(solids), std::move(waters), water, waterNames); // validates every point set
+	const long needed = solver_->subStepsFor(dt);
+	if (needed > maxSubSteps) {
+		const mpm::TimeStepLimits limits = solver_->timeStepLimits(dt);
+		std::ostringstream        msg;
+		msg << "O.dt = " << dt << " s needs " << needed << " sub-steps of timeStepFactor × criticalTimeStep = " << timeStepFactor << " × "
+		    << limits.critical << " s, more than maxSubSteps = " << maxSubSteps << ": lower O.dt (at most "
+		    << maxSubSteps * timeStepFactor * limits.critical << " s) or raise maxSubSteps (nothing was advanced)";
+		throw mpm::InvalidParameter(msg.str());
+	}
 	subStepsLast     = solver_->advance(dt);
 	criticalTimeStep = solver_->lastTimeStepLimits().critical;
 	pressureSolveIterations = solver_->lastPressureSolve().iterations;
@@ -157,7 +168,7 @@ void MpmTwoPhaseEngine::action()
 MpmTwoPhaseEngine::Structure MpmTwoPhaseEngine::structure() const
 {
 	return Structure { scheme, pressureTolerance, gravity,       timeStepFactor, flipBlend,  domainMin,  domainMax,  cellSize,               shapeFunction, drag,
-		           cellAveraging, pressureModeDamping, freeSurfaceThreshold, freeSurfaceHoldsSuction, solidWalls, wallFriction, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow, periodic };
+		           cellAveraging, pressureModeDamping, freeSurfaceThreshold, freeSurfaceHoldsSuction, solidWalls, wallFriction, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow, periodic, maxSubSteps };
 }
 
 void MpmTwoPhaseEngine::callPostLoad()
@@ -186,6 +197,8 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 	static const AttrTable<E> table {
 		vector3Attr("gravity", &E::gravity, "Gravitational acceleration acting on both phases b [m s⁻²]"),
 		realAttr("timeStepFactor", &E::timeStepFactor, "Safety factor C on the critical time step [-], 0 < C ≤ 1; O.dt is split into sub-steps no larger than C × criticalTimeStep"),
+		intAttr("maxSubSteps", &E::maxSubSteps,
+		        "Most sub-steps one O.dt may be split into [-], ≥ 1, default 100000: an O.dt that would need more (a mistyped step, e.g. 10 s for a 1e-4 s critical step) is refused before any work, naming O.dt, criticalTimeStep and the sub-steps needed"),
 		realAttr("flipBlend", &E::flipBlend, "FLIP/PIC blend α of the grid-to-point velocity update [-], 0 ≤ α ≤ 1 (1 = pure FLIP, 0 = PIC)"),
 		vector3Attr("domainMin", &E::domainMin, "Lower corner of the domain box, whose faces are the walls [m]"),
 		vector3Attr("domainMax", &E::domainMax, "Upper corner of the domain box; each extent a whole number of cells [m]"),
@@ -260,6 +273,7 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& boost::serialization::make_nvp("GlobalEngine", boost::serialization::base_object<yade::GlobalEngine>(*this));
 	serializeVector3(ar, "gravity", gravity);
 	ar& BOOST_SERIALIZATION_NVP(timeStepFactor);
+	ar& BOOST_SERIALIZATION_NVP(maxSubSteps);
 	ar& BOOST_SERIALIZATION_NVP(flipBlend);
 	serializeVector3(ar, "domainMin", domainMin);
 	serializeVector3(ar, "domainMax", domainMax);

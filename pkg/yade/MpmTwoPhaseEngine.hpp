@@ -19,6 +19,7 @@ public:
 	// inputs
 	yade::Vector3r gravity        = yade::Vector3r::Zero(); // b [m s⁻²], body acceleration of both phases
 	yade::Real     timeStepFactor = 0.5;                    // C [-] in (0, 1]: safety factor on the critical step
+	long           maxSubSteps    = 100000;                 // [-] ≥ 1: most sub-steps one O.dt may take
 	yade::Real     flipBlend      = 1.0;                    // α [-] in [0, 1]: 1 = FLIP, 0 = PIC
 	yade::Vector3r domainMin      = yade::Vector3r::Zero(); // lower corner of the domain box (walls) [m]
 	yade::Vector3r domainMax      = yade::Vector3r::Ones(); // upper corner [m]
@@ -73,7 +74,7 @@ private:
 	// Everything the solver is built from except the values held on drained faces, which a
 	// running solver takes over in place (a rising head set every step must not rebuild it).
 	using Structure = std::tuple<std::string, yade::Real, yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, bool, yade::Real, bool,
-	                             std::vector<std::string>, std::vector<yade::Real>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>, std::vector<int>>;
+	                             std::vector<std::string>, std::vector<yade::Real>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>, std::vector<int>, long>;
 	Structure structure() const;
 
 	std::unique_ptr<mpm::TwoPhaseSolver> solver_;  // not serialized: rebuilt on first action()

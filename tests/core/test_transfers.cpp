@@ -105,6 +105,7 @@ TEST(GridToParticle, LinearFieldIsInterpolatedExactly)
 	A << 0.3, -1.2, 0.5, 2.0, 0.1, -0.7, 0.4, 0.9, -0.2;
 	const Vec3 b(0.1, -0.2, 0.3);
 	std::vector<Vec3> field(box.grid.nodeCount()), zero(box.grid.nodeCount(), Vec3::Zero());
+	const std::vector<Real> ones(box.grid.nodeCount(), 1.0);
 	for (int k = 0; k < box.grid.nodes[2]; ++k)
 		for (int j = 0; j < box.grid.nodes[1]; ++j)
 			for (int i = 0; i < box.grid.nodes[0]; ++i) field[box.grid.index(i, j, k)] = A * box.grid.nodePosition(i, j, k) + b;
@@ -113,10 +114,10 @@ TEST(GridToParticle, LinearFieldIsInterpolatedExactly)
 		const auto        x0 = s.position;
 		std::vector<Mat3> L;
 		if (gimp) {
-			stages::updatePointKinematics<GimpKernel>(box.grid, zero, field, s, 1e-3, 0.0); // PIC: v_p = Σ S v_I
+			stages::updatePointKinematics<GimpKernel>(box.grid, zero, field, ones, nullptr, s, 1e-3, 0.0); // PIC: v_p = Σ S v_I
 			stages::computeVelocityGradients<GimpKernel>(box.grid, field, s, L);
 		} else {
-			stages::updatePointKinematics<LinearKernel>(box.grid, zero, field, s, 1e-3, 0.0);
+			stages::updatePointKinematics<LinearKernel>(box.grid, zero, field, ones, nullptr, s, 1e-3, 0.0);
 			stages::computeVelocityGradients<LinearKernel>(box.grid, field, s, L);
 		}
 		for (std::size_t p = 0; p < s.size(); ++p) {
@@ -125,6 +126,40 @@ TEST(GridToParticle, LinearFieldIsInterpolatedExactly)
 			EXPECT_LT((L[p] - A).norm(), 1e-11) << (gimp ? "GIMP" : "linear");
 		}
 	}
+}
+
+// theory.md eq. 4.11b: the drag Q (w − v) per node acts, implicitly, on the velocity a point
+// carries beyond the grid's: with nodal drag Q and phase mass m, FLIP keeps the fraction
+// 1/(1 + Δt Q/m) of it (the backward-Euler solution of m u̇ = −Q u over one step), and a
+// velocity the grid carries is left alone (a point on a uniform grid field moves with it).
+TEST(GridToParticle, DragDampsOnlyTheVelocityTheGridDoesNotCarry)
+{
+	std::mt19937_64 rng(5);
+	Box             box;
+	const Real      dt = 2e-4, Q = 300, ms = 1.2, mw = 0.4;
+	for (std::size_t I = 0; I < box.grid.nodeCount(); ++I) {
+		box.fields.solid[I].mass = ms;
+		box.fields.solid[I].drag = Q;
+		box.fields.water[I].mass = mw;
+	}
+	std::vector<Real> solidKept, waterKept;
+	stages::dragRetention(box.fields, true, 1e-12, 1e-12, dt, solidKept);
+	stages::dragRetention(box.fields, false, 1e-12, 1e-12, dt, waterKept);
+	EXPECT_NEAR(solidKept[7], 1 / (1 + dt * Q / ms), 1e-15);
+	EXPECT_NEAR(waterKept[7], 1 / (1 + dt * Q / mw), 1e-15);
+	const Vec3              uniform(0.2, -0.1, 0.3);
+	const std::vector<Vec3> grid(box.grid.nodeCount(), uniform);
+	SolidPointSet           s = randomSolid(200, rng);
+	const auto              v0 = s.velocity;
+	stages::updatePointKinematics<GimpKernel>(box.grid, grid, grid, waterKept, nullptr, s, dt, 1.0); // FLIP
+	for (std::size_t p = 0; p < s.size(); ++p)
+		EXPECT_LT((s.velocity[p] - (uniform + waterKept[7] * (v0[p] - uniform))).norm(), 1e-13);
+	box.fields.solid[3].drag = 0; // no drag, no mass: nothing damped
+	box.fields.water[4].mass = 0;
+	stages::dragRetention(box.fields, true, 1e-12, 1e-12, dt, solidKept);
+	stages::dragRetention(box.fields, false, 1e-12, 1e-12, dt, waterKept);
+	EXPECT_EQ(solidKept[3], 1.0);
+	EXPECT_EQ(waterKept[4], 1.0);
 }
 
 TEST(PatchTest, UniformStressGivesZeroInteriorForceAndUniformStrainUniformStress)

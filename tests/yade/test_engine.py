@@ -95,3 +95,31 @@ def test_saturated_block_geostatic_state():
         yade_mpm.saturated_block((0, 0, 0), (0.15, 0.1, 1.0), 0.1, soil, water)
     with pytest.raises(ValueError, match="must point along −z"):
         yade_mpm.saturated_block((0, 0, 0), (0.1, 0.1, 1.0), 0.1, soil, water, gravity=(1, 0, 0))
+
+
+def test_an_o_dt_far_above_the_critical_step_is_refused_before_any_work():
+    """Issue 17 item 1: O.dt = 1000 s on a column whose critical step is ~1e-4 s would be ~10⁷
+    sub-steps (hours): refused at the step, naming O.dt, criticalTimeStep and the sub-steps needed, with the
+    state untouched; a raised maxSubSteps lets a larger O.dt through, split as documented."""
+    soil, water = w.MpmSoilMat(), w.MpmWaterMat()
+    O.materials.append([soil, water])
+    g = (0, 0, -9.81)
+    solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (0.05, 0.05, 0.1), 0.05, soil, water, points_per_cell=2, gravity=g)
+    O.bodies.append([solid_body, water_body])
+    engine = w.MpmTwoPhaseEngine(label="mpm", gravity=g, domainMin=(0, 0, 0), domainMax=(0.05, 0.05, 0.1), cellSize=0.05,
+                                 solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("drained",))
+    O.engines = [engine]
+    positions, pressures = solid_body.shape.pos.copy(), water_body.shape.porePressure.copy()
+    O.dt = 1000.0
+    with pytest.raises(ValueError, match=r"O.dt = 1000 s needs (\d+) sub-steps of timeStepFactor × criticalTimeStep = 0.5 × [0-9.e-]+ s, "
+                                         r"more than maxSubSteps = 100000: lower O.dt \(at most [0-9.e-]+ s\)"):
+        O.step()
+    assert engine.stepsDone == 0 and engine.mpmTime == 0 and O.iter == 0 and O.time == 0
+    assert np.array_equal(solid_body.shape.pos, positions) and np.array_equal(water_body.shape.porePressure, pressures)
+    with pytest.raises(ValueError, match=r"maxSubSteps = 0 is outside the valid range \[1, inf\)"):
+        engine.maxSubSteps = 0
+    engine.maxSubSteps = 40
+    O.dt = 1e-3  # a few times the critical step of this 5 cm column: within 40 sub-steps
+    O.step()
+    assert engine.stepsDone == 1 and 1 < engine.subStepsLast <= 40
+    assert engine.subStepsLast == int(np.ceil(1e-3 / (engine.timeStepFactor * engine.criticalTimeStep)))
