@@ -198,7 +198,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		vector3Attr("gravity", &E::gravity, "Gravitational acceleration acting on both phases b [m s⁻²]"),
 		realAttr("timeStepFactor", &E::timeStepFactor, "Safety factor C on the critical time step [-], 0 < C ≤ 1; O.dt is split into sub-steps no larger than C × criticalTimeStep"),
 		intAttr("maxSubSteps", &E::maxSubSteps,
-		        "Most sub-steps one O.dt may be split into [-], ≥ 1, default 100000: an O.dt that would need more (a mistyped step, e.g. 10 s for a 1e-4 s critical step) is refused before any work, naming O.dt, criticalTimeStep and the sub-steps needed"),
+		        "Most sub-steps one O.dt may be split into [-], ≥ 1: an O.dt that would need more (a mistyped step, e.g. 10 s for a 1e-4 s critical step) is refused before any work, naming O.dt, criticalTimeStep and the sub-steps needed"),
 		realAttr("flipBlend", &E::flipBlend, "FLIP/PIC blend α of the grid-to-point velocity update [-], 0 ≤ α ≤ 1 (1 = pure FLIP, 0 = PIC)"),
 		vector3Attr("domainMin", &E::domainMin, "Lower corner of the domain box, whose faces are the walls [m]"),
 		vector3Attr("domainMax", &E::domainMax, "Upper corner of the domain box; each extent a whole number of cells [m]"),

@@ -228,7 +228,15 @@ template <class T, class Base> void registerPythonClass(py::object scope, const 
 		auto get = py::make_function(PropertyGetter<T> { i }, py::default_call_policies(), boost::mpl::vector2<py::object, T&>());
 		if (table[i].set) {
 			auto set = py::make_function(PropertySetter<T> { i }, py::default_call_policies(), boost::mpl::vector3<void, T&, const py::object&>());
-			cls.add_property(table[i].name.c_str(), get, set, table[i].doc.c_str());
+			// every input states its default, read from a default-constructed instance (per-point
+			// arrays, empty by default, are left out)
+			std::string doc = table[i].doc;
+			const py::object value = table[i].get(probe);
+			if (!PyObject_HasAttrString(value.ptr(), "shape")) {
+				const std::string shown = py::extract<std::string>(py::import("builtins").attr("repr")(value));
+				doc += " (default: " + shown + ")";
+			}
+			cls.add_property(table[i].name.c_str(), get, set, doc.c_str());
 		} else {
 			cls.add_property(table[i].name.c_str(), get, table[i].doc.c_str());
 		}

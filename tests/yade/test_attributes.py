@@ -121,3 +121,17 @@ def test_setting_pos_resizes_all_fields_keeping_existing_values():
     assert np.array_equal(solid.mass, [1, 2, 3, 0, 0])
     solid.pos = np.zeros((2, 3))
     assert np.array_equal(solid.mass, [1, 2])
+
+
+@pytest.mark.parametrize("name", ["MpmTwoPhaseEngine", "MpmSoilMat", "MpmWaterMat", "MpmHdf5Recorder"])
+def test_every_input_documents_its_unit_and_default(name):
+    """Issue 17 item 10: each settable attribute's docstring states its unit (in brackets) and ends
+    with its default, read from a fresh instance, so the two cannot drift apart."""
+    cls = getattr(w, name)
+    fresh = cls()
+    inputs = [a for a, p in vars(cls).items() if isinstance(p, property) and p.fset is not None and not a.startswith("_")]
+    assert inputs
+    for attribute in inputs:
+        doc = getattr(cls, attribute).__doc__
+        assert "[" in doc and "]" in doc, (name, attribute, doc)
+        assert doc.endswith("(default: %r)" % (getattr(fresh, attribute),)), (name, attribute, doc)
