@@ -100,7 +100,7 @@ engine = MpmTwoPhaseEngine(
     freeSurfaceHoldsSuction=True,  # ... held by capillarity above the phreatic line, a seepage face below it
     removeFreeWater=True)       # the filtering cloth
 recorder = MpmHdf5Recorder(label="recorder", file=os.path.join(OUT, "sandpile.h5"), iterPeriod=1)
-O.engines = [engine, recorder]
+O.engines = [engine, recorder, yade_mpm.progress(seconds=60)]  # a progress line with an ETA every minute
 
 
 def head_table(t):
@@ -149,6 +149,7 @@ def mass_balance():
 # --- run -------------------------------------------------------------------------------------------
 # O.dt is the interval at which the head is updated; the engine sub-steps it to its stable step.
 O.dt = 2e-4
+O.stopAtTime = DURATION  # the end of the head history; also what the progress ETA refers to
 steps_per_record = int(round(RECORD_INTERVAL / O.dt))
 records_per_frame = int(round(FIELD_INTERVAL / RECORD_INTERVAL))
 rows, snapshots = [], {}

@@ -8,22 +8,22 @@ was built for, then registers the classes ``MpmTwoPhaseEngine``, ``MpmSolidPoint
 import os
 import sys
 
-_YADE_PY_DIR = "/usr/lib/x86_64-linux-gnu/yade-double/py"
+from . import _buildinfo  # plain values written by the build: safe before YADE is loaded
 
 if "yade" not in sys.modules:
     try:
         import yade  # noqa: F401  (boots YADE)
     except ImportError:
-        # Debian's dist-packages/yade link points to a directory yade-double does not use.
-        if os.path.isdir(_YADE_PY_DIR) and _YADE_PY_DIR not in sys.path:
-            sys.path.insert(1, _YADE_PY_DIR)
+        # Debian's dist-packages/yade link points to a directory yade-double does not use; the
+        # build recorded the one it linked against
+        if os.path.isdir(_buildinfo.yade_python_dir) and _buildinfo.yade_python_dir not in sys.path:
+            sys.path.insert(1, _buildinfo.yade_python_dir)
         import yade  # noqa: F401
 
 import yade
 import yade.config
 import yade.wrapper
 
-from . import _buildinfo
 from ._guard import YadeAbiMismatch, check_compatibility, self_test
 
 check_compatibility(yade.config, _buildinfo)
@@ -34,9 +34,10 @@ _yade_mpm.registerClasses(yade.wrapper)
 self_test(_yade_mpm, yade.wrapper, yade.wrapper.Omega())
 
 from yade.wrapper import MpmHdf5Recorder, MpmSoilMat, MpmSolidPoints, MpmTwoPhaseEngine, MpmWaterMat, MpmWaterPoints  # noqa: E402
-from . import analytical, builders, results, sandpile  # noqa: E402
+from . import analytical, builders, monitor, results, sandpile  # noqa: E402
 from .builders import saturated_block, saturated_points  # noqa: E402
+from .monitor import progress  # noqa: E402
 
 __version__ = _buildinfo.package_version
 __all__ = ["MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat", "MpmHdf5Recorder", "YadeAbiMismatch",
-           "saturated_block", "saturated_points"]
+           "saturated_block", "saturated_points", "progress"]
