@@ -9,6 +9,7 @@
 #include "../core/Errors.hpp"
 
 #include <array>
+#include <map>
 #include <sstream>
 #include <limits>
 
@@ -114,16 +115,25 @@ void MpmTwoPhaseEngine::action()
 		builtFor_ = structure();
 	}
 
+	refuseSecondEngine();
 	std::vector<mpm::SolidSet>       solids;
 	std::vector<mpm::WaterPointSet*> waters;
 	std::vector<std::string>         waterNames;
 	mpm::WaterParameters             water;
 	bool                             haveWater = false;
 	long                             solid = 0, fluid = 0;
+	std::map<const void*, int>       owner; // point-set shape → the first body that carries it
 	for (const auto& body : yade::abi::bodies(scene)) {
 		if (!body) continue; // erased body
 		const auto&       shape = yade::abi::shapeOf(body.get());
-		const std::string where = "O.bodies[" + std::to_string(yade::abi::idOf(body.get())) + "]";
+		const int         id    = yade::abi::idOf(body.get());
+		const std::string where = "O.bodies[" + std::to_string(id) + "]";
+		if (dynamic_cast<MpmSolidPoints*>(shape.get()) || dynamic_cast<MpmWaterPoints*>(shape.get())) {
+			const auto [first, fresh] = owner.emplace(shape.get(), id);
+			if (!fresh)
+				throw mpm::InvalidParameter("O.bodies[" + std::to_string(first->second) + "] and " + where + " share one " + shape->getClassName() +
+				                            " shape: its points would be advanced twice per step; give each body its own shape (e.g. a copy)");
+		}
 		if (auto* s = dynamic_cast<MpmSolidPoints*>(shape.get())) {
 			auto* mat = dynamic_cast<MpmSoilMat*>(yade::abi::materialOf(body.get()).get());
 			if (!mat) throw mpm::InvalidParameter(where + " carries MpmSolidPoints but its material is not an MpmSoilMat");
@@ -163,6 +173,22 @@ void MpmTwoPhaseEngine::action()
 	lastIter         = yade::abi::iter(scene);
 	mpmTime += dt;
 	++stepsDone;
+}
+
+void MpmTwoPhaseEngine::refuseSecondEngine() const
+{
+	std::string found;
+	int         active = 0;
+	const auto& engines = yade::abi::engines(scene);
+	for (std::size_t i = 0; i < engines.size(); ++i) {
+		const auto* other = dynamic_cast<const MpmTwoPhaseEngine*>(engines[i].get());
+		if (!other || other->dead) continue;
+		++active;
+		found += (found.empty() ? "" : ", ") + std::string("O.engines[") + std::to_string(i) + "]" + (other->label.empty() ? "" : " (label '" + other->label + "')");
+	}
+	if (active > 1)
+		throw mpm::InvalidParameter("O.engines holds " + std::to_string(active) + " active MpmTwoPhaseEngines: " + found +
+		                            "; each advances every MPM body of the scene, so the points would move twice per step: keep one (or set dead=True on the others)");
 }
 
 MpmTwoPhaseEngine::Structure MpmTwoPhaseEngine::structure() const

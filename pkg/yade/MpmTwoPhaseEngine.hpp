@@ -76,6 +76,8 @@ private:
 	using Structure = std::tuple<std::string, yade::Real, yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, bool, yade::Real, bool,
 	                             std::vector<std::string>, std::vector<yade::Real>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>, std::vector<int>, long>;
 	Structure structure() const;
+	// Refuses a scene whose O.engines holds another active MpmTwoPhaseEngine (issue 17 item 2).
+	void refuseSecondEngine() const;
 
 	std::unique_ptr<mpm::TwoPhaseSolver> solver_;  // not serialized: rebuilt on first action()
 	Structure                            builtFor_ {};

@@ -229,12 +229,17 @@ template <class T, class Base> void registerPythonClass(py::object scope, const 
 		if (table[i].set) {
 			auto set = py::make_function(PropertySetter<T> { i }, py::default_call_policies(), boost::mpl::vector3<void, T&, const py::object&>());
 			// every input states its default, read from a default-constructed instance (per-point
-			// arrays, empty by default, are left out)
+			// arrays, empty by default, are left out). At YADE's boot the converters of some values
+			// (Vector3r) are not registered yet: their default is then left out of the docstring.
 			std::string doc = table[i].doc;
-			const py::object value = table[i].get(probe);
-			if (!PyObject_HasAttrString(value.ptr(), "shape")) {
-				const std::string shown = py::extract<std::string>(py::import("builtins").attr("repr")(value));
-				doc += " (default: " + shown + ")";
+			try {
+				const py::object value = table[i].get(probe);
+				if (!PyObject_HasAttrString(value.ptr(), "shape")) {
+					const std::string shown = py::extract<std::string>(py::import("builtins").attr("repr")(value));
+					doc += " (default: " + shown + ")";
+				}
+			} catch (const py::error_already_set&) {
+				PyErr_Clear();
 			}
 			cls.add_property(table[i].name.c_str(), get, set, doc.c_str());
 		} else {

@@ -123,3 +123,28 @@ def test_an_o_dt_far_above_the_critical_step_is_refused_before_any_work():
     O.step()
     assert engine.stepsDone == 1 and 1 < engine.subStepsLast <= 40
     assert engine.subStepsLast == int(np.ceil(1e-3 / (engine.timeStepFactor * engine.criticalTimeStep)))
+
+
+def test_two_engines_or_a_shared_point_set_are_refused_before_any_work():
+    """Issue 17 item 2: two active MpmTwoPhaseEngines would each advance every MPM body (twice per
+    step), and one point-set shape in two bodies would be advanced twice by one engine: both are
+    refused at the first step, naming the engines or the bodies, with nothing advanced."""
+    soil, water = w.MpmSoilMat(), w.MpmWaterMat()
+    O.materials.append([soil, water])
+    solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (0.05, 0.05, 0.1), 0.05, soil, water, points_per_cell=2)
+    O.bodies.append([solid_body, water_body])
+    box = dict(domainMin=(0, 0, 0), domainMax=(0.05, 0.05, 0.1), cellSize=0.05)
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm", **box), w.ForceResetter(), w.MpmTwoPhaseEngine(label="again", **box)]
+    O.dt = 1e-4
+    with pytest.raises(ValueError, match=r"O.engines holds 2 active MpmTwoPhaseEngines: O.engines\[0\] \(label 'mpm'\), "
+                                         r"O.engines\[2\] \(label 'again'\).*keep one \(or set dead=True on the others\)"):
+        O.step()
+    assert O.engines[0].stepsDone == 0 and O.engines[2].stepsDone == 0 and O.iter == 0
+    O.engines[2].dead = True  # a dead second engine is allowed
+    O.step()
+    assert O.engines[0].stepsDone == 1
+    O.bodies.append(w.Body(shape=solid_body.shape, material=soil))  # the same shape object in a third body
+    positions = solid_body.shape.pos.copy()
+    with pytest.raises(ValueError, match=r"O.bodies\[0\] and O.bodies\[2\] share one MpmSolidPoints shape"):
+        O.step()
+    assert O.engines[0].stepsDone == 1 and np.array_equal(solid_body.shape.pos, positions)
