@@ -19,12 +19,28 @@ namespace {
 	template <class T> bool allFinite(const T& x) { return x.allFinite(); }
 	inline bool             allFinite(Real x) { return std::isfinite(x); }
 
-	template <class Field> void requireFinite(const std::string& setName, const char* field, const Field& f)
+	template <class T> std::string shown(const T& x)
+	{
+		std::ostringstream out;
+		out << "(";
+		for (Eigen::Index i = 0; i < x.size(); ++i) out << (i ? ", " : "") << x.coeff(i);
+		out << ")";
+		return out.str();
+	}
+	inline std::string shown(Real x)
+	{
+		std::ostringstream out;
+		out << x;
+		return out.str();
+	}
+
+	template <class Field> void requireFinite(const std::string& setName, const char* field, const Field& f, const char* unit)
 	{
 		for (std::size_t i = 0; i < f.size(); ++i)
 			if (!allFinite(f[i])) {
 				std::ostringstream msg;
-				msg << setName << "." << field << "[" << i << "] is not finite";
+				msg << setName << "." << field << "[" << i << "] = " << shown(f[i]) << (*unit ? " " : "") << unit
+				    << " is outside the valid range: finite values";
 				throw InvalidParameter(msg.str());
 			}
 	}
@@ -50,15 +66,15 @@ void MaterialPointSet::resizeCommon(std::size_t n)
 	halfLength.resize(n, Vec3::Zero());
 }
 
-void MaterialPointSet::validate(const std::string& setName) const
+void MaterialPointSet::validate(const std::string& setName, const PointFieldNames& names) const
 {
 	const std::size_t n = size();
-	requireSize(setName, "velocity", velocity, n);
+	requireSize(setName, names.velocity, velocity, n);
 	requireSize(setName, "mass", mass, n);
 	requireSize(setName, "volume", volume, n);
 	requireSize(setName, "halfLength", halfLength, n);
-	requireFinite(setName, "position", position);
-	requireFinite(setName, "velocity", velocity);
+	requireFinite(setName, names.position, position, "m");
+	requireFinite(setName, names.velocity, velocity, "m s⁻¹");
 	requirePositive(setName, "mass", mass, "kg");
 	requirePositive(setName, "volume", volume, "m³");
 	for (std::size_t i = 0; i < n; ++i)
@@ -78,22 +94,22 @@ void SolidPointSet::resize(std::size_t n)
 	plasticShearStrain.resize(n, 0);
 }
 
-void SolidPointSet::validate(const std::string& setName) const
+void SolidPointSet::validate(const std::string& setName, const PointFieldNames& names) const
 {
-	MaterialPointSet::validate(setName);
+	MaterialPointSet::validate(setName, names);
 	const std::size_t n = size();
 	requireSize(setName, "initialVolume", initialVolume, n);
 	requireSize(setName, "initialHalfLength", initialHalfLength, n);
-	requireSize(setName, "deformationGradient", deformationGradient, n);
-	requireSize(setName, "effectiveStress", effectiveStress, n);
+	requireSize(setName, names.deformationGradient, deformationGradient, n);
+	requireSize(setName, names.effectiveStress, effectiveStress, n);
 	requireSize(setName, "porosity", porosity, n);
-	requireSize(setName, "externalForce", externalForce, n);
+	requireSize(setName, names.externalForce, externalForce, n);
 	requireSize(setName, "plasticShearStrain", plasticShearStrain, n);
 	requirePositive(setName, "initialVolume", initialVolume, "m³");
-	requireFinite(setName, "externalForce", externalForce);
-	requireFinite(setName, "plasticShearStrain", plasticShearStrain);
-	requireFinite(setName, "deformationGradient", deformationGradient);
-	requireFinite(setName, "effectiveStress", effectiveStress);
+	requireFinite(setName, names.externalForce, externalForce, "N");
+	requireFinite(setName, "plasticShearStrain", plasticShearStrain, "");
+	requireFinite(setName, names.deformationGradient, deformationGradient, "");
+	requireFinite(setName, names.effectiveStress, effectiveStress, "Pa");
 	requirePorosity(setName, porosity, false);
 }
 
@@ -104,13 +120,13 @@ void WaterPointSet::resize(std::size_t n)
 	porosity.resize(n, 1);
 }
 
-void WaterPointSet::validate(const std::string& setName) const
+void WaterPointSet::validate(const std::string& setName, const PointFieldNames& names) const
 {
-	MaterialPointSet::validate(setName);
+	MaterialPointSet::validate(setName, names);
 	const std::size_t n = size();
 	requireSize(setName, "porePressure", porePressure, n);
 	requireSize(setName, "porosity", porosity, n);
-	requireFinite(setName, "porePressure", porePressure);
+	requireFinite(setName, "porePressure", porePressure, "Pa");
 	requirePorosity(setName, porosity, true);
 }
 

@@ -9,6 +9,16 @@
 
 namespace mpm {
 
+// How messages spell the point fields: the C++ member names by default; a binding passes the names
+// its users see (e.g. "pos" for position).
+struct PointFieldNames {
+	const char* position            = "position";
+	const char* velocity            = "velocity";
+	const char* deformationGradient = "deformationGradient";
+	const char* effectiveStress     = "effectiveStress";
+	const char* externalForce       = "externalForce";
+};
+
 // Fields every material point carries, whatever its phase.
 struct MaterialPointSet {
 	std::vector<Vec3> position;   // x_p [m]
@@ -19,8 +29,8 @@ struct MaterialPointSet {
 
 	std::size_t size() const { return position.size(); }
 	// Check that every field has size() entries and holds finite, admissible values; throws
-	// InvalidParameter naming the set, field, point index and value.
-	void validate(const std::string& setName) const;
+	// InvalidParameter naming the set, field (as `names` spells it), point index and value.
+	void validate(const std::string& setName, const PointFieldNames& names = {}) const;
 
 protected:
 	void resizeCommon(std::size_t n);
@@ -37,7 +47,7 @@ struct SolidPointSet : MaterialPointSet {
 	std::vector<Real>   plasticShearStrain;  // κ [-], accumulated plastic shear strain (theory.md eq. 7.4)
 
 	void resize(std::size_t n);
-	void validate(const std::string& setName) const;
+	void validate(const std::string& setName, const PointFieldNames& names = {}) const;
 };
 
 // Pore-water points: carry the pore pressure; their porosity is interpolated from the solid.
@@ -46,7 +56,7 @@ struct WaterPointSet : MaterialPointSet {
 	std::vector<Real> porosity;     // n_p [-], 1 for free water
 
 	void resize(std::size_t n);
-	void validate(const std::string& setName) const;
+	void validate(const std::string& setName, const PointFieldNames& names = {}) const;
 	// Remove the points whose `remove` flag is set, keeping the order of the others; returns the
 	// mass removed [kg].
 	Real removeWhere(const std::vector<char>& remove);

@@ -125,19 +125,21 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 		solids[s].soil.validate();
 		if (solids[s].model != SkeletonModel::LinearElastic) solids[s].strength.validate();
 		if (solids[s].name.empty()) solids[s].name = "solid set " + std::to_string(s);
-		solids[s].points->validate(solids[s].name);
+		solids[s].points->validate(solids[s].name, fieldNames_);
 		requireDomainsInACell(*solids[s].points, solids[s].name);
 		minSolid = smallestMass(*solids[s].points, minSolid);
 	}
 	for (std::size_t w = 0; w < waters.size(); ++w) {
 		const std::string name = w < waterNames.size() ? waterNames[w] : "water set " + std::to_string(w);
-		waters[w]->validate(name);
+		waters[w]->validate(name, fieldNames_);
 		requireDomainsInACell(*waters[w], name);
 		minWater = smallestMass(*waters[w], minWater);
 	}
 	solids_ = std::move(solids);
 	waters_ = std::move(waters);
 	water_  = water;
+	waterNames_.clear();
+	for (std::size_t w = 0; w < waters_.size(); ++w) waterNames_.push_back(w < waterNames.size() ? waterNames[w] : "water set " + std::to_string(w));
 	// consolidation coefficient c_v = κ M / μw of the fastest-draining soil (eq. 4.17b)
 	pressureDiffusivity_ = 0;
 	for (const SolidSet& set : solids_) {
@@ -146,7 +148,7 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 	}
 	solidMassTolerance_ = std::isfinite(minSolid) ? emptyNodeMassFraction * minSolid : 0;
 	waterMassTolerance_ = std::isfinite(minWater) ? emptyNodeMassFraction * minWater : 0;
-	throwIfOutsideGrid();
+	throwIfOutsideGrid(true);
 }
 
 TimeStepLimits TwoPhaseSolver::timeStepLimits(Real horizon) const
@@ -218,7 +220,13 @@ long TwoPhaseSolver::advance(Real dt)
 		    << lastLimits_.critical << " s, more than maxSubSteps = " << settings_.maxSubSteps;
 		throw InvalidParameter(msg.str());
 	}
-	for (long i = 0; i < substeps; ++i) step(dt / substeps);
+	for (long i = 0; i < substeps; ++i) {
+		try {
+			step(dt / substeps);
+		} catch (const InstabilityError& e) {
+			throw InstabilityError(std::string(e.what()) + " (sub-step " + std::to_string(i + 1) + " of " + std::to_string(substeps) + ")");
+		}
+	}
 	return substeps;
 }
 
@@ -311,11 +319,11 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 {
 	{
 		StageTimer t(stageSeconds_, Stage::UpdatePointKinematics);
-		auto check = [&](long bad, const char* phase, std::size_t set, const MaterialPointSet& points) {
+		auto check = [&](long bad, const std::string& name, const MaterialPointSet& points) {
 			if (bad < 0) return;
 			std::ostringstream msg;
-			msg << "unstable at step " << steps_ << ": " << phase << " set " << set << ", point " << bad << " at (" << points.position[bad].transpose()
-			    << ") m: velocity |v| = " << points.velocity[bad].norm() << " m/s"
+			msg << "unstable in solver step " << steps_ << ": " << name << "." << fieldNames_.velocity << "[" << bad << "] = (" << points.velocity[bad].transpose()
+			    << ") m s⁻¹ at " << fieldNames_.position << " (" << points.position[bad].transpose() << ") m: |v| = " << points.velocity[bad].norm() << " m/s"
 			    << (points.velocity[bad].allFinite() ? " moves it more than one cell (" + std::to_string(grid_.cellSize) + " m) in one step of " + std::to_string(dt) + " s"
 			                                         : " is not finite")
 			    << " (reduce O.dt or timeStepFactor, or check the drag scheme and the boundary conditions)";
@@ -345,15 +353,15 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 		for (std::size_t s = 0; s < solids_.size(); ++s)
 			check(stages::updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, solidRetention_,
 			                                            exchange ? &solidDragLoss_ : nullptr, *solids_[s].points, dt, settings_.flipBlend),
-			      "solid", s, *solids_[s].points);
+			      solids_[s].name, *solids_[s].points);
 		for (std::size_t w = 0; w < waters_.size(); ++w)
 			check(stages::updatePointKinematics<Kernel>(grid_, fields_.waterVelocity, fields_.waterVelocityNew, waterRetention_,
 			                                            exchange ? &waterDragLoss_ : nullptr, *waters_[w], dt, settings_.flipBlend),
-			      "water", w, *waters_[w]);
+			      waterNames_[w], *waters_[w]);
 	}
 	removeOutflowingWater();
 	injectInflowingWater();
-	throwIfOutsideGrid();
+	throwIfOutsideGrid(false);
 }
 
 template <class Kernel> void TwoPhaseSolver::remap(bool wet)
@@ -515,21 +523,24 @@ void TwoPhaseSolver::injectInflowingWater()
 	}
 }
 
-void TwoPhaseSolver::throwIfOutsideGrid() const
+void TwoPhaseSolver::throwIfOutsideGrid(bool setup) const
 {
-	auto check = [&](const MaterialPointSet& set, const char* phase, std::size_t index) {
+	auto check = [&](const MaterialPointSet& set, const std::string& name) {
 		const long p = settings_.shapeFunction == ShapeFunction::Linear ? stages::firstPointOutsideGrid<LinearKernel>(grid_, set)
 		                                                                 : stages::firstPointOutsideGrid<GimpKernel>(grid_, set);
 		if (p < 0) return;
 		std::ostringstream msg;
-		msg << "at step " << steps_ << ": " << phase << " set " << index << ", point " << p << " at (" << set.position[p].transpose()
-		    << ") m is outside the grid, which spans the domain (" << grid_.lower().transpose() << ")..(" << grid_.upper().transpose()
-		    << ") m plus one cell";
+		if (!setup) msg << "unstable in solver step " << steps_ << ": ";
+		const Vec3 x = set.position[p], lo = grid_.lower(), hi = grid_.upper();
+		msg << name << "." << fieldNames_.position << "[" << p << "] = (" << x[0] << ", " << x[1] << ", " << x[2]
+		    << ") m is outside the grid, which spans the domain (" << lo[0] << ", " << lo[1] << ", " << lo[2] << ")..(" << hi[0] << ", " << hi[1] << ", "
+		    << hi[2] << ") m plus one cell";
+		if (setup) throw InvalidParameter(msg.str() + " (every point's stencil must lie on the grid)");
 		throw InstabilityError(msg.str());
 	};
-	for (std::size_t s = 0; s < solids_.size(); ++s) check(*solids_[s].points, "solid", s);
+	for (const SolidSet& s : solids_) check(*s.points, s.name);
 	if (domain_.removeWaterLeavingGrid) return; // removeOutflowingWater has taken those already
-	for (std::size_t w = 0; w < waters_.size(); ++w) check(*waters_[w], "water", w);
+	for (std::size_t w = 0; w < waters_.size(); ++w) check(*waters_[w], waterNames_[w]);
 }
 
 } // namespace mpm

@@ -77,6 +77,8 @@ public:
 	// a set by SolidSet::name or `waterNames[i]` (default "solid set i" / "water set i").
 	void setPoints(std::vector<SolidSet> solids, std::vector<WaterPointSet*> waters, const WaterParameters& water,
 	               const std::vector<std::string>& waterNames = {});
+	// How messages spell the point fields (a binding's names; the C++ ones by default).
+	void setFieldNames(const PointFieldNames& names) { fieldNames_ = names; }
 
 	// `horizon` [s]: the time the limits must hold over (advance's dt). The semi-implicit step of
 	// water with no skeleton is bounded by no wave, so there the points' speed is taken as they may
@@ -120,7 +122,8 @@ private:
 	template <class Kernel> void updateSkeleton(Real dt);
 	template <class Kernel> void updateWater(Real dt, bool semiImplicit);
 	void                         updateDomains();
-	void                         throwIfOutsideGrid() const;
+	// A point whose stencil leaves the grid: bad input at `setup` (InvalidParameter), else InstabilityError.
+	void                         throwIfOutsideGrid(bool setup) const;
 
 	Domain                        domain_;
 	SolverSettings                settings_;
@@ -143,6 +146,8 @@ private:
 	std::vector<long>             inflowNearest_;
 	std::vector<Real>             inflowDepth_;
 	std::vector<Real>             solidRetention_, waterRetention_; // eq. 4.11b per node [-]
+	std::vector<std::string>      waterNames_;                      // per water set, for messages
+	PointFieldNames               fieldNames_;
 	std::vector<Vec3>             solidDragLoss_, waterDragLoss_;   // eq. 4.11c per node: momentum lost, then velocity received [m s⁻¹]
 	std::vector<std::vector<Vec3>> lossBuffers_;
 	TimeStepLimits                lastLimits_ {};

@@ -18,8 +18,8 @@ namespace {
 		static const std::string posDoc  = std::string("Positions of the ") + phase + " points, shape (N, 3) [m]. Assigning it sets the number of points N.";
 		static const std::string velDoc  = std::string("Velocities of the ") + phase + " points, shape (N, 3) [m s⁻¹]";
 		return {
-			pointArrayAttr("pos", points, &mpm::MaterialPointSet::position, posDoc.c_str(), true),
-			pointArrayAttr("vel", points, &mpm::MaterialPointSet::velocity, velDoc.c_str()),
+			pointArrayAttr(pointFieldNames.position, points, &mpm::MaterialPointSet::position, posDoc.c_str(), true),
+			pointArrayAttr(pointFieldNames.velocity, points, &mpm::MaterialPointSet::velocity, velDoc.c_str()),
 			pointArrayAttr("volume", points, &mpm::MaterialPointSet::volume, "Current mixture volume represented by each point, shape (N,) [m³]"),
 			pointArrayAttr("halfLength", points, &mpm::MaterialPointSet::halfLength, "GIMP half-lengths of each point's domain l_p, shape (N, 3) [m]"),
 			readOnly(AttrSpec<Owner> { "count", "Number of points N [-]", [points](const Owner& o) { return py::object((o.*points).size()); }, nullptr }),
@@ -45,12 +45,12 @@ const AttrTable<MpmSolidPoints>& MpmSolidPoints::attributes()
 		             pointArrayAttr("mass", &S::points, &SolidPointSet::mass, "Solid mass of each point m_sp = (1−n0) ρs V0, shape (N,) [kg]"),
 		             pointArrayAttr("initialVolume", &S::points, &SolidPointSet::initialVolume, "Initial mixture volume of each point V0, shape (N,) [m³]"),
 		             pointArrayAttr("initialHalfLength", &S::points, &SolidPointSet::initialHalfLength, "Initial GIMP half-lengths l0_p, shape (N, 3) [m]"),
-		             pointArrayAttr("defGrad", &S::points, &SolidPointSet::deformationGradient, "Deformation gradient F of each point, shape (N, 3, 3) [-]"),
-		             pointArrayAttr("stress", &S::points, &SolidPointSet::effectiveStress, "Effective stress σ′ (tension-positive), symmetric, shape (N, 3, 3) [Pa]"),
+		             pointArrayAttr(pointFieldNames.deformationGradient, &S::points, &SolidPointSet::deformationGradient, "Deformation gradient F of each point, shape (N, 3, 3) [-]"),
+		             pointArrayAttr(pointFieldNames.effectiveStress, &S::points, &SolidPointSet::effectiveStress, "Effective stress σ′ (tension-positive), symmetric, shape (N, 3, 3) [Pa]"),
 		             pointArrayAttr("porosity", &S::points, &SolidPointSet::porosity, "Porosity n of the mixture at each solid point, shape (N,) [-]"),
 		             pointArrayAttr("plasticShearStrain", &S::points, &SolidPointSet::plasticShearStrain,
 		                            "Accumulated plastic shear strain κ of each point, shape (N,) [-]"),
-		             pointArrayAttr("extForce", &S::points, &SolidPointSet::externalForce,
+		             pointArrayAttr(pointFieldNames.externalForce, &S::points, &SolidPointSet::externalForce,
 		                            "Prescribed load on each point, e.g. a surface traction times the point's face area, shape (N, 3) [N]"),
 		     })
 			t.push_back(std::move(spec));

@@ -112,6 +112,7 @@ void MpmTwoPhaseEngine::action()
 	const yade::Real dt = yade::abi::dt(scene);
 	if (!solver_) {
 		solver_   = std::make_unique<mpm::TwoPhaseSolver>(domain(), settings());
+		solver_->setFieldNames(pointFieldNames);
 		builtFor_ = structure();
 	}
 
@@ -161,7 +162,13 @@ void MpmTwoPhaseEngine::action()
 		    << maxSubSteps * timeStepFactor * limits.critical << " s) or raise maxSubSteps (nothing was advanced)";
 		throw mpm::InvalidParameter(msg.str());
 	}
-	subStepsLast     = solver_->advance(dt);
+	try {
+		subStepsLast = solver_->advance(dt);
+	} catch (const mpm::InstabilityError& e) {
+		std::ostringstream msg;
+		msg << "O.iter = " << yade::abi::iter(scene) << " (O.time = " << yade::abi::time(scene) << " s): " << e.what();
+		throw mpm::InstabilityError(msg.str());
+	}
 	criticalTimeStep = solver_->lastTimeStepLimits().critical;
 	pressureSolveIterations = solver_->lastPressureSolve().iterations;
 	solverSteps      = solver_->stepCount();

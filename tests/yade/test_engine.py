@@ -148,3 +148,26 @@ def test_two_engines_or_a_shared_point_set_are_refused_before_any_work():
     with pytest.raises(ValueError, match=r"O.bodies\[0\] and O.bodies\[2\] share one MpmSolidPoints shape"):
         O.step()
     assert O.engines[0].stepsDone == 1 and np.array_equal(solid_body.shape.pos, positions)
+
+
+@pytest.mark.parametrize("field, index, value, message", [
+    ("pos", 3, (0.0125, float("nan"), 0.0875), r"O.bodies\[0\].shape.pos\[3\] = \(0.0125, nan, 0.0875\) m is outside the valid range: finite values"),
+    ("vel", 2, (1.0, float("nan"), 0.0), r"O.bodies\[0\].shape.vel\[2\] = \(1, nan, 0\) m s⁻¹ is outside the valid range: finite values"),
+    ("extForce", 5, (0.0, 0.0, float("inf")), r"O.bodies\[0\].shape.extForce\[5\] = \(0, 0, inf\) N is outside the valid range: finite values"),
+    ("pos", 7, (0.5, 0.0, 0.0), r"O.bodies\[0\].shape.pos\[7\] = \(0.5, 0, 0\) m is outside the grid, which spans the domain \(0, 0, 0\)..\(0.05, 0.05, 0.1\) m"),
+])
+def test_bad_point_arrays_are_named_as_python_spells_them(field, index, value, message):
+    """Issue 17 item 6: messages use the Python attribute names (pos, vel, extForce, not the core's
+    position, velocity, externalForce), show the bad value with its unit, and nothing advances."""
+    soil, water = w.MpmSoilMat(), w.MpmWaterMat()
+    O.materials.append([soil, water])
+    solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (0.05, 0.05, 0.1), 0.05, soil, water, points_per_cell=2)
+    O.bodies.append([solid_body, water_body])
+    array = getattr(solid_body.shape, field)
+    array[index] = value
+    setattr(solid_body.shape, field, array)
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm", domainMin=(0, 0, 0), domainMax=(0.05, 0.05, 0.1), cellSize=0.05)]
+    O.dt = 1e-4
+    with pytest.raises(ValueError, match=message):
+        O.step()
+    assert O.engines[0].stepsDone == 0 and O.iter == 0
