@@ -11,6 +11,13 @@ namespace mpm {
 
 namespace {
 	constexpr double inf = std::numeric_limits<double>::infinity();
+	// "(x, y, z)" as in Python's tuples
+	std::string shown(const Vec3& x)
+	{
+		std::ostringstream out;
+		out << "(" << x[0] << ", " << x[1] << ", " << x[2] << ")";
+		return out.str();
+	}
 	// A node whose mass is below this fraction of the lightest point's is empty (velocity 0, theory.md
 	// §4 Step 5): the round-off of a product of three GIMP weights. A coarser cut drops the momentum
 	// the points carry through their outer weights: 1e-9 lost 2e-8 of the gravity impulse of a free
@@ -322,8 +329,8 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 		auto check = [&](long bad, const std::string& name, const MaterialPointSet& points) {
 			if (bad < 0) return;
 			std::ostringstream msg;
-			msg << "unstable in solver step " << steps_ << ": " << name << "." << fieldNames_.velocity << "[" << bad << "] = (" << points.velocity[bad].transpose()
-			    << ") m s⁻¹ at " << fieldNames_.position << " (" << points.position[bad].transpose() << ") m: |v| = " << points.velocity[bad].norm() << " m/s"
+			msg << "unstable in solver step " << steps_ << ": " << name << "." << fieldNames_.velocity << "[" << bad << "] = " << shown(points.velocity[bad])
+			    << " m s⁻¹ at " << fieldNames_.position << " " << shown(points.position[bad]) << " m: |v| = " << points.velocity[bad].norm() << " m/s"
 			    << (points.velocity[bad].allFinite() ? " moves it more than one cell (" + std::to_string(grid_.cellSize) + " m) in one step of " + std::to_string(dt) + " s"
 			                                         : " is not finite")
 			    << " (reduce O.dt or timeStepFactor, or check the drag scheme and the boundary conditions)";
@@ -531,10 +538,8 @@ void TwoPhaseSolver::throwIfOutsideGrid(bool setup) const
 		if (p < 0) return;
 		std::ostringstream msg;
 		if (!setup) msg << "unstable in solver step " << steps_ << ": ";
-		const Vec3 x = set.position[p], lo = grid_.lower(), hi = grid_.upper();
-		msg << name << "." << fieldNames_.position << "[" << p << "] = (" << x[0] << ", " << x[1] << ", " << x[2]
-		    << ") m is outside the grid, which spans the domain (" << lo[0] << ", " << lo[1] << ", " << lo[2] << ")..(" << hi[0] << ", " << hi[1] << ", "
-		    << hi[2] << ") m plus one cell";
+		msg << name << "." << fieldNames_.position << "[" << p << "] = " << shown(set.position[p]) << " m is outside the grid, which spans the domain "
+		    << shown(grid_.lower()) << ".." << shown(grid_.upper()) << " m plus one cell";
 		if (setup) throw InvalidParameter(msg.str() + " (every point's stencil must lie on the grid)");
 		throw InstabilityError(msg.str());
 	};
