@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   yade cmake make g++ libeigen3-dev libboost-python-dev libboost-serialization-dev
   libhdf5-dev googletest libgtest-dev python3-dev python3-pytest python3-numpy python3-h5py
-  python3-matplotlib
+  python3-matplotlib paraview
 )
 missing=()
 for p in "${packages[@]}"; do

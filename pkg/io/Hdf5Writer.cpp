@@ -42,6 +42,29 @@ namespace {
 		H5Sclose(space);
 	}
 
+	// "/polyvertex/<n>": the indices 0..n−1, written once per point count and shared by every record
+	// and set with that many points (XDMF's Polyvertex topology then has one cell per point)
+	std::string polyvertexCells(hid_t file, std::size_t n)
+	{
+		const std::string name = "/polyvertex/" + std::to_string(n);
+		if (H5Lexists(file, "polyvertex", H5P_DEFAULT) <= 0) {
+			const hid_t group = H5Gcreate2(file, "polyvertex", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+			if (group < 0) throw std::runtime_error("HDF5: could not create group polyvertex");
+			H5Gclose(group);
+		}
+		if (H5Lexists(file, name.c_str(), H5P_DEFAULT) > 0) return name;
+		std::vector<long long> index(n);
+		for (std::size_t i = 0; i < n; ++i) index[i] = static_cast<long long>(i);
+		const hsize_t dims[1] = { n };
+		const hid_t   space   = H5Screate_simple(1, dims, nullptr);
+		const hid_t   set     = H5Dcreate2(file, name.c_str(), H5T_STD_I64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+		if (set < 0) throw std::runtime_error("HDF5: could not create dataset " + name);
+		check(H5Dwrite(set, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, index.data()), "write dataset " + name);
+		H5Dclose(set);
+		H5Sclose(space);
+		return name;
+	}
+
 	const char* attributeType(std::size_t columns) { return columns == 1 ? "Scalar" : columns == 3 ? "Vector" : "Tensor"; }
 
 	void requireFinite(const std::string& owner, const FieldView& f)
@@ -89,6 +112,7 @@ void Hdf5Writer::write(long iteration, double time, const std::vector<PointSetSn
 		for (const auto& f : s.fields) {
 			writeDataset(sub, f);
 			layout.fields.push_back(FieldView { f.name, {}, f.rows, f.columns });
+			if (f.name == "position") polyvertexCells(file, f.rows);
 		}
 		index.layout.push_back(layout);
 		H5Gclose(sub);
@@ -124,8 +148,11 @@ void Hdf5Writer::writeXdmf() const
 			std::size_t n = 0;
 			for (const auto& f : s.fields)
 				if (f.name == "position") n = f.rows;
+			// one Polyvertex cell per point, with its connectivity: ParaView's Xdmf3 reader makes a
+			// single cell of all the points without it
 			x << "    <Grid Name=\"" << s.name << "\" GridType=\"Uniform\">\n     <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n
-			  << "\" NodesPerElement=\"1\"/>\n     <Geometry GeometryType=\"XYZ\"><DataItem Dimensions=\"" << n << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">"
+			  << "\" NodesPerElement=\"1\"><DataItem Dimensions=\"" << n << " 1\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">" << h5
+			  << ":/polyvertex/" << n << "</DataItem></Topology>\n     <Geometry GeometryType=\"XYZ\"><DataItem Dimensions=\"" << n << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">"
 			  << h5 << ":/" << r.group << "/" << s.name << "/position</DataItem></Geometry>\n";
 			for (const auto& f : s.fields) {
 				if (f.name == "position") continue;

@@ -82,3 +82,57 @@ def test_recorder_attributes_and_period_validation(tmp_path):
         scene(tmp_path, 1)
         O.engines[1].file = str(tmp_path / "missing" / "dir" / "run.h5")
         O.step()
+
+
+PARAVIEW_CHECK = """
+import json, sys
+from paraview.simple import OpenDataFile
+from paraview import servermanager
+reader = OpenDataFile(sys.argv[1])
+reader.UpdatePipelineInformation()
+times = list(reader.TimestepValues)
+blocks = []
+def walk(data):
+    if data.IsA("vtkMultiBlockDataSet"):
+        for i in range(data.GetNumberOfBlocks()):
+            walk(data.GetBlock(i))
+    elif data.IsA("vtkMultiPieceDataSet"):
+        for i in range(data.GetNumberOfPieces()):
+            walk(data.GetPiece(i))
+    else:
+        arrays = data.GetPointData()
+        blocks.append([data.GetClassName(), data.GetNumberOfPoints(), data.GetNumberOfCells(),
+                       sorted(arrays.GetArrayName(i) for i in range(arrays.GetNumberOfArrays()))])
+reader.UpdatePipeline(times[-1])
+walk(servermanager.Fetch(reader))
+print("PARAVIEW", json.dumps({"reader": reader.GetXMLName(), "times": times, "blocks": blocks}))
+"""
+
+
+def test_paraview_default_reader_shows_one_cell_per_point(tmp_path):
+    """Issue 17 item 8: Debian's ParaView (pvpython, the reader OpenDataFile picks for .xmf,
+    Xdmf3ReaderS) loads every time step, shows N cells for the N points of each set (one Polyvertex
+    cell per point: without the connectivity it made one cell, or none, of them all) with their
+    fields, and the grid."""
+    import json
+    import shutil
+    import subprocess
+    pvpython = shutil.which("pvpython")
+    assert pvpython, "pvpython not found: scripts/install-deps.sh installs Debian's paraview"
+    solid, fluid = scene(tmp_path, 5)
+    O.run(11, True)
+    script = tmp_path / "check.py"
+    script.write_text(PARAVIEW_CHECK)
+    done = subprocess.run([pvpython, str(script), str(tmp_path / "run.xmf")], capture_output=True, text=True, timeout=120,
+                          env={"HOME": str(tmp_path), "PATH": "/usr/bin:/bin"}, stdin=subprocess.DEVNULL)
+    lines = [l for l in done.stdout.splitlines() if l.startswith("PARAVIEW ")]
+    assert lines, done.stdout[-2000:] + done.stderr[-2000:]
+    seen = json.loads(lines[0][len("PARAVIEW "):])
+    assert seen["reader"] == "Xdmf3ReaderS"
+    assert seen["times"] == pytest.approx([r.time for r in results.read(str(tmp_path / "run.h5"))])
+    sets = sorted((count, cells) for kind, count, cells, _ in seen["blocks"] if kind == "vtkUnstructuredGrid")
+    assert sets == sorted([(solid.count, solid.count), (fluid.count, fluid.count)])  # N cells for the N points of each set
+    assert "vtkUniformGrid" in [b[0] for b in seen["blocks"]]
+    arrays = [b[3] for b in seen["blocks"] if b[0] == "vtkUnstructuredGrid"]
+    assert ["porePressure", "porosity", "velocity", "volume"] in arrays
+    assert any({"stress", "velocity", "porosity"} <= set(a) for a in arrays)
