@@ -3,6 +3,7 @@
 #include <hdf5.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -87,8 +88,39 @@ Hdf5Writer::Hdf5Writer(std::string path)
 	H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); // errors are reported by exceptions
 	const hid_t file = H5Fcreate(path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
 	if (file < 0) throw std::runtime_error("HDF5: cannot create '" + path_ + "' (does its directory exist and is it writable?)");
+	{
+		const hid_t type = H5Tcopy(H5T_C_S1);
+		H5Tset_size(type, std::strlen(marker));
+		const hid_t space = H5Screate(H5S_SCALAR);
+		const hid_t attr  = H5Acreate2(file, "writer", type, space, H5P_DEFAULT, H5P_DEFAULT);
+		check(H5Awrite(attr, type, marker), "write the writer attribute");
+		H5Aclose(attr);
+		H5Sclose(space);
+		H5Tclose(type);
+	}
 	H5Fclose(file);
 	writeXdmf();
+}
+
+bool Hdf5Writer::writtenByUs(const std::string& path)
+{
+	H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+	if (H5Fis_hdf5(path.c_str()) <= 0) return false;
+	const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+	if (file < 0) return false;
+	bool ours = false;
+	if (H5Aexists(file, "writer") > 0) {
+		const hid_t attr = H5Aopen(file, "writer", H5P_DEFAULT);
+		const hid_t type = H5Aget_type(attr);
+		if (H5Tget_class(type) == H5T_STRING && H5Tget_size(type) == std::strlen(marker)) {
+			std::string value(std::strlen(marker), '\0');
+			ours = H5Aread(attr, type, value.data()) >= 0 && value == marker;
+		}
+		H5Tclose(type);
+		H5Aclose(attr);
+	}
+	H5Fclose(file);
+	return ours;
 }
 
 void Hdf5Writer::write(long iteration, double time, const std::vector<PointSetSnapshot>& sets, const GridSnapshot* grid)

@@ -36,6 +36,10 @@ class Hdf5Writer {
 public:
 	// Writes `path` (HDF5) and `path` with ".xmf" replacing the extension (XDMF).
 	explicit Hdf5Writer(std::string path);
+	// The root attribute that marks a file as this writer's (an earlier run's output, which a new
+	// writer may replace), and whether `path` is such a file.
+	static constexpr const char* marker = "yade-mpm MpmHdf5Recorder";
+	static bool writtenByUs(const std::string& path);
 	// Append one record. Throws std::runtime_error naming the set, field and row of a non-finite
 	// value, or the HDF5 failure.
 	void write(long iteration, double time, const std::vector<PointSetSnapshot>& sets, const GridSnapshot* grid);

@@ -6,7 +6,12 @@
 
 #include "../core/Errors.hpp"
 
+#include <cctype>
+#include <climits>
+#include <cstdlib>
 #include <fstream>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace yade_mpm {
 
@@ -52,9 +57,7 @@ void MpmHdf5Recorder::action()
 	const long iter = yade::abi::iter(scene);
 	if (lastRecord >= 0 && iter - lastRecord < iterPeriod) return;
 	if (!writer_) {
-		if (records > 0 && std::ifstream(file).good())
-			throw std::runtime_error("MpmHdf5Recorder: '" + file + "' already holds " + std::to_string(records)
-			                         + " records of this scene; set MpmHdf5Recorder.file to a new name to continue recording (nothing is overwritten)");
+		checkFile(&yade::abi::engines(scene));
 		writer_ = std::make_unique<mpm::io::Hdf5Writer>(file);
 	}
 	std::vector<mpm::io::PointSetSnapshot> sets;
@@ -107,11 +110,68 @@ void MpmHdf5Recorder::action()
 	++records;
 }
 
+namespace {
+	std::string directoryOf(const std::string& path)
+	{
+		const auto slash = path.find_last_of('/');
+		return slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+	}
+	// the directory resolved (symbolic links, "..") plus the file name: two spellings of one file compare equal
+	std::string canonical(const std::string& path)
+	{
+		char resolved[PATH_MAX];
+		const std::string dir = directoryOf(path);
+		if (!realpath(dir.c_str(), resolved)) return path;
+		return std::string(resolved) + "/" + path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+	}
+	bool endsWith(const std::string& s, const std::string& tail)
+	{
+		if (s.size() < tail.size()) return false;
+		for (std::size_t i = 0; i < tail.size(); ++i)
+			if (std::tolower(static_cast<unsigned char>(s[s.size() - tail.size() + i])) != tail[i]) return false;
+		return true;
+	}
+} // namespace
+
+void MpmHdf5Recorder::checkFile(const std::vector<boost::shared_ptr<yade::Engine>>* engines) const
+{
+	const std::string named = "MpmHdf5Recorder.file = '" + file + "'";
+	if (file.empty()) throw mpm::InvalidParameter("MpmHdf5Recorder.file = '' is outside the valid range: a file name");
+	if (endsWith(file, ".xmf"))
+		throw mpm::InvalidParameter(named + ": the XDMF index is written next to the HDF5 file with the extension .xmf; name the HDF5 file (e.g. '" +
+		                            file.substr(0, file.size() - 4) + ".h5')");
+	const std::string dir = directoryOf(file);
+	struct stat info {};
+	if (stat(dir.c_str(), &info) != 0 || !S_ISDIR(info.st_mode)) throw mpm::InvalidParameter(named + ": its directory '" + dir + "' does not exist");
+	if (access(dir.c_str(), W_OK) != 0) throw mpm::InvalidParameter(named + ": its directory '" + dir + "' is not writable");
+	if (!engines) return;
+	if (!writer_ && access(file.c_str(), F_OK) == 0) {
+		if (!mpm::io::Hdf5Writer::writtenByUs(file))
+			throw mpm::InvalidParameter(named + " exists and is not an MpmHdf5Recorder's HDF5 file: refusing to overwrite it (remove it or choose another name)");
+		if (records > 0)
+			throw mpm::InvalidParameter(named + " already holds " + std::to_string(records) +
+			                            " records of this scene (it was saved after recording): set MpmHdf5Recorder.file to a new name to continue recording (nothing is overwritten)");
+		// an earlier run's output of a recorder that has not recorded yet: replaced (the stated policy)
+	}
+	const std::string mine = canonical(file);
+	for (std::size_t i = 0; i < engines->size(); ++i) {
+		const auto* other = dynamic_cast<const MpmHdf5Recorder*>((*engines)[i].get());
+		if (!other || other == this || other->dead) continue;
+		if (canonical(other->file) == mine)
+			throw mpm::InvalidParameter(named + " is also the file of O.engines[" + std::to_string(i) + "]" +
+			                            (other->label.empty() ? "" : " (label '" + other->label + "')") + ": two recorders would write one file; give each its own");
+	}
+}
+
 void MpmHdf5Recorder::callPostLoad()
 {
 	yade::GlobalEngine::callPostLoad();
-	if (iterPeriod < 1) raisePython(PyExc_ValueError, "MpmHdf5Recorder: iterPeriod = " + std::to_string(iterPeriod) + " is outside the valid range [1, inf)");
-	if (file.empty()) raisePython(PyExc_ValueError, "MpmHdf5Recorder: file must not be empty");
+	if (iterPeriod < 1) raisePython(PyExc_ValueError, "MpmHdf5Recorder.iterPeriod = " + std::to_string(iterPeriod) + " is outside the valid range [1, inf)");
+	try {
+		checkFile(nullptr);
+	} catch (const mpm::InvalidParameter& e) {
+		raisePython(PyExc_ValueError, e.what());
+	}
 }
 
 const AttrTable<MpmHdf5Recorder>& MpmHdf5Recorder::attributes()

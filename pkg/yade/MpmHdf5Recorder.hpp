@@ -24,6 +24,13 @@ public:
 	~MpmHdf5Recorder() override;
 	void action() override;
 	void callPostLoad() override;
+	// Refuses, before anything is advanced or written, a file this recorder cannot or must not
+	// write: an .xmf name, a missing or read-only directory, an existing file that is not an
+	// MpmHdf5Recorder's HDF5, an earlier record of this recorder (after O.load), or another active
+	// recorder in `engines` writing to the same file. Messages name the attribute and the value.
+	// `engines` null: the name-level checks only (when the attribute is set or the scene loaded).
+	void checkFile(const std::vector<boost::shared_ptr<yade::Engine>>* engines) const;
+	bool started() const { return writer_ != nullptr; }
 	void pyRegisterClass(boost::python::object scope) override;
 	template <class Archive> void serialize(Archive& ar, unsigned int version);
 	MPM_SERIALIZABLE_OVERRIDES(MpmHdf5Recorder, GlobalEngine)

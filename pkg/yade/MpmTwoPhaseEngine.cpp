@@ -1,5 +1,6 @@
 #include "MpmTwoPhaseEngine.hpp"
 
+#include "MpmHdf5Recorder.hpp"
 #include "MpmMaterials.hpp"
 #include "MpmPointShapes.hpp"
 #include "Serialization.hpp"
@@ -117,6 +118,10 @@ void MpmTwoPhaseEngine::action()
 	}
 
 	refuseSecondEngine();
+	// the recorders' files are checked before anything advances (a recorder runs after this engine)
+	for (const auto& engine : yade::abi::engines(scene))
+		if (const auto* recorder = dynamic_cast<const MpmHdf5Recorder*>(engine.get()); recorder && !recorder->dead && !recorder->started())
+			recorder->checkFile(&yade::abi::engines(scene));
 	std::vector<mpm::SolidSet>       solids;
 	std::vector<mpm::WaterPointSet*> waters;
 	std::vector<std::string>         waterNames;

@@ -78,10 +78,40 @@ def test_non_finite_values_are_refused_and_earlier_records_survive(tmp_path):
 def test_recorder_attributes_and_period_validation(tmp_path):
     with pytest.raises(ValueError, match=r"iterPeriod = 0 is outside the valid range"):
         w.MpmHdf5Recorder(iterPeriod=0)
-    with pytest.raises(RuntimeError, match="cannot create"):
-        scene(tmp_path, 1)
-        O.engines[1].file = str(tmp_path / "missing" / "dir" / "run.h5")
+
+
+def test_recorder_files_are_checked_before_anything_advances(tmp_path):
+    """Issue 17 item 5: a file the recorder cannot or must not write is refused when it is set, or at
+    the first step before the MPM engine advances (mpmTime stays equal to O.time): a missing
+    directory, an .xmf name (the index goes next to the HDF5 file), an existing file that is not a
+    recorder's HDF5 (never overwritten), two recorders on one file. Policy: an earlier run's HDF5 of a
+    recorder is replaced by a recorder that has not recorded yet."""
+    missing = tmp_path / "missing" / "dir" / "run.h5"
+    with pytest.raises(ValueError, match=r"MpmHdf5Recorder.file = '.*run.h5': its directory '.*missing/dir' does not exist"):
+        w.MpmHdf5Recorder(file=str(missing))
+    with pytest.raises(ValueError, match=r"MpmHdf5Recorder.file = '.*run.xmf': the XDMF index is written next to the HDF5 file"):
+        w.MpmHdf5Recorder(file=str(tmp_path / "run.xmf"))
+    foreign = tmp_path / "run.h5"
+    foreign.write_text("my notes, not an HDF5 file")
+    solid, fluid = scene(tmp_path, 1)
+    engine = O.engines[0]
+    with pytest.raises(ValueError, match=r"MpmHdf5Recorder.file = '.*run.h5' exists and is not an MpmHdf5Recorder's HDF5 file: refusing to overwrite it"):
         O.step()
+    assert foreign.read_text() == "my notes, not an HDF5 file"
+    assert engine.stepsDone == 0 and engine.mpmTime == O.time == 0 and O.iter == 0
+    O.engines = O.engines + [w.MpmHdf5Recorder(label="second", file=str(tmp_path / "." / "other.h5"), iterPeriod=1),
+                             w.MpmHdf5Recorder(label="third", file=str(tmp_path / "other.h5"))]
+    O.engines[1].file = str(tmp_path / "first.h5")
+    with pytest.raises(ValueError, match=r"other.h5' is also the file of O.engines\[3\] \(label 'third'\): two recorders would write one file"):
+        O.step()
+    assert engine.stepsDone == 0 and engine.mpmTime == O.time == 0
+    O.engines = O.engines[:3]
+    O.run(2, True)
+    assert engine.mpmTime == pytest.approx(O.time) and O.engines[1].records == 2 == O.engines[2].records
+    # an earlier run's file: a fresh recorder replaces it
+    O.engines = O.engines[:1] + [w.MpmHdf5Recorder(file=str(tmp_path / "first.h5"), iterPeriod=1)]
+    O.run(1, True)
+    assert len(results.read(str(tmp_path / "first.h5"))) == 1
 
 
 PARAVIEW_CHECK = """
@@ -136,3 +166,21 @@ def test_paraview_default_reader_shows_one_cell_per_point(tmp_path):
     arrays = [b[3] for b in seen["blocks"] if b[0] == "vtkUnstructuredGrid"]
     assert ["porePressure", "porosity", "velocity", "volume"] in arrays
     assert any({"stress", "velocity", "porosity"} <= set(a) for a in arrays)
+
+
+def test_a_reloaded_recorder_does_not_write_over_its_records(tmp_path):
+    """After O.save/O.load a recorder that has recorded refuses, before the engine advances, to start
+    its file again (it would replace the records); a new file name continues."""
+    scene(tmp_path, 1)
+    O.run(2, True)
+    O.saveTmp("recorded")
+    O.loadTmp("recorded")
+    engine, recorder = O.engines[0], O.engines[1]
+    steps, time = engine.stepsDone, O.time
+    with pytest.raises(ValueError, match=r"MpmHdf5Recorder.file = '.*run.h5' already holds 2 records of this scene"):
+        O.step()
+    assert engine.stepsDone == steps and O.time == time and engine.mpmTime == pytest.approx(O.time)
+    assert len(results.read(str(tmp_path / "run.h5"))) == 2
+    recorder.file = str(tmp_path / "continued.h5")
+    O.step()
+    assert len(results.read(str(tmp_path / "continued.h5"))) == 1
