@@ -34,9 +34,11 @@ _yade_mpm.registerClasses(yade.wrapper)
 self_test(_yade_mpm, yade.wrapper, yade.wrapper.Omega())
 
 from yade.wrapper import MpmHdf5Recorder, MpmSoilMat, MpmSolidPoints, MpmTwoPhaseEngine, MpmWaterMat, MpmWaterPoints  # noqa: E402
-from . import analytical, builders, monitor, results, sandpile  # noqa: E402
+from . import _scenefiles, analytical, builders, monitor, results, sandpile  # noqa: E402
 from .builders import saturated_block, saturated_points  # noqa: E402
 from .monitor import progress  # noqa: E402
+
+_scenefiles.install()  # O.load / O.loadTmp name the file when a saved scene cannot be read
 
 __version__ = _buildinfo.package_version
 __all__ = ["MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat", "MpmHdf5Recorder", "YadeAbiMismatch",

@@ -108,3 +108,35 @@ def test_loading_without_the_plugin_fails_cleanly(tmp_path):
     """ % str(path), tmp_path, name="load_without.py")
     assert "unregistered class" in result.stdout, result.stdout + result.stderr
     assert "ALIVE 1" in result.stdout
+
+
+def small_scene():
+    soil, water = w.MpmSoilMat(), w.MpmWaterMat()
+    O.materials.append([soil, water])
+    O.bodies.append(list(yade_mpm.saturated_block((0, 0, 0), (0.1, 0.05, 0.2), 0.05, soil, water, points_per_cell=2)))
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm", domainMin=(0, 0, 0), domainMax=(0.1, 0.05, 0.2), cellSize=0.05)]
+    O.dt = 1e-4
+    O.run(2, True)
+
+
+def test_a_truncated_or_corrupt_saved_scene_is_reported_at_the_load_naming_the_file(tmp_path):
+    """Issue 17 item 7: YADE's own load error ("input stream error") names neither the file nor the
+    cause, and a value spoilt in the file used to surface as an instability of the first step; now
+    the load names the file and what is wrong."""
+    small_scene()
+    saved = tmp_path / "scene.xml"
+    O.save(str(saved))
+    text = saved.read_text()
+    truncated = tmp_path / "truncated.xml"
+    truncated.write_text(text[: len(text) * 2 // 3])
+    with pytest.raises(RuntimeError, match=r"O.load\('.*truncated.xml'\): the saved scene cannot be read \(.*\): the file is missing, truncated or corrupt"):
+        O.load(str(truncated))
+    start = text.index("<porePressure>")
+    item = text.index("<item>", start)
+    spoilt = tmp_path / "spoilt.xml"
+    spoilt.write_text(text[:item] + "<item>nan</item>" + text[text.index("</item>", item) + len("</item>"):])
+    with pytest.raises(ValueError, match=r"O.load\('.*spoilt.xml'\): O.bodies\[1\].shape.porePressure\[0\] = nan is not finite: the saved scene is corrupt"):
+        O.load(str(spoilt))
+    O.load(str(saved))  # the intact file still loads and runs
+    O.step()
+    assert O.engines[0].stepsDone == 3
