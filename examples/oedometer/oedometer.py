@@ -50,13 +50,7 @@ cv = analytical.consolidation_coefficient(soil.intrinsicPermeability, water.visc
                                           soil.porosity, water.bulkModulus)
 
 # the undrained start: water carries p0, the skeleton the rest of the load (uniaxial strain)
-sigma_z = -(LOAD - p0)
-k0 = soil.poissonRatio / (1 - soil.poissonRatio)
-stress = np.zeros((solid.count, 3, 3))
-stress[:, 0, 0] = stress[:, 1, 1] = k0 * sigma_z
-stress[:, 2, 2] = sigma_z
-solid.stress = stress
-fluid.porePressure = np.full(fluid.count, p0)
+assert yade_mpm.builders.sudden_uniaxial_load(solid_body, water_body, soil, water, LOAD) == p0
 spacing = CELL / 2
 load = np.zeros((solid.count, 3))
 load[solid.pos[:, 2] > HEIGHT - spacing, 2] = -LOAD * spacing ** 2  # traction q on the top points' faces

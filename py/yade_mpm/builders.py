@@ -36,16 +36,18 @@ def saturated_block(lower, upper, cell_size, soil, water, points_per_cell=2, gra
 
     lower, upper: box corners [m]; cell_size: grid cell size h [m]; soil: MpmSoilMat; water:
     MpmWaterMat; points_per_cell: points per cell and axis (each point gets V0 = (h/ppc)³);
-    gravity: b [m s⁻²], along −z or zero; water_table: elevation of zero pore pressure [m]
-    (default: top of the block); lateral_earth_pressure: K0 [-] (default ν/(1−ν), uniaxial strain);
-    geostatic: start from hydrostatic pore pressure and the effective stress of the buoyant weight
-    (else stress-free, zero pore pressure).
+    gravity: b [m s⁻²], zero, along −z, or tilted (b_z < 0) for an infinite slope whose surface is
+    the block's top (z is the slope normal, see saturated_points); water_table: elevation of zero
+    pore pressure [m] (default: top of the block); lateral_earth_pressure: K0 [-] (default ν/(1−ν),
+    uniaxial strain); geostatic: start from hydrostatic pore pressure and the effective stress of the
+    buoyant weight (else stress-free, zero pore pressure).
 
     Returns (solid_body, water_body), two non-dynamic Bodies to append to O.bodies.
     """
     gravity = np.asarray(gravity, dtype=float)
-    if gravity.shape != (3,) or gravity[0] != 0 or gravity[1] != 0 or gravity[2] > 0:
-        raise ValueError("gravity = %r m s⁻² must point along −z (or be zero) for a geostatic start" % (gravity.tolist(),))
+    if gravity.shape != (3,) or not np.isfinite(gravity).all() or gravity[2] > 0 or (gravity[2] == 0 and gravity.any()):
+        raise ValueError("gravity = %r m s⁻² is outside the valid range: zero, or with a downward z component (b_z < 0) for a "
+                         "geostatic start" % (gravity.tolist(),))
     positions, spacing = _lattice(lower, upper, cell_size, points_per_cell)
     surface = float(upper[2])
     return saturated_points(positions, spacing, soil, water, gravity=gravity if geostatic else (0.0, 0.0, 0.0),
@@ -58,12 +60,17 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
     """Solid and water points at the same `positions` (N×3 [m]), each the centre of a cube of side
     `spacing` [m] (V0 = spacing³, GIMP half-length spacing/2), with porosity soil.porosity.
 
-    With gravity (along −z) and `surface` (N elevations of the ground surface above each point [m]),
-    the start is geostatic as under level ground: hydrostatic pore pressure below `water_table`
-    [m], σ′_zz = −(ρsat g (surface − z) − p), σ′_xx = σ′_yy = K0 σ′_zz with K0 =
+    With gravity (b_z < 0) and `surface` (N elevations of the ground surface above each point [m]),
+    the start is geostatic: hydrostatic pore pressure p = ρw |b_z| (table − z) below `water_table`
+    [m], σ′_zz = −(ρsat |b_z| (surface − z) − p), σ′_xx = σ′_yy = K0 σ′_zz with K0 =
     `lateral_earth_pressure` (default ν/(1−ν)). Above the table p = 0, or with
-    `suction_above_table` the hydrostatic suction p = −ρw g (z − table) of soil held saturated by
-    capillarity (water at rest everywhere). Without gravity the points start stress-free at p = 0.
+    `suction_above_table` the hydrostatic suction p = −ρw |b_z| (z − table) of soil held saturated
+    by capillarity. A tilted gravity (b_x, b_y ≠ 0) makes the ground an infinite slope with z its
+    normal: the skeleton carries the downslope weight of the whole mixture in shear,
+    σ′_xz = ρsat b_x (surface − z), σ′_yz = ρsat b_y (surface − z), and the water seeps parallel to
+    the slope at Darcy's rate, n (v_w − v_s) = (κ/μw) ρw (b_x, b_y, 0), which its drag hands to the
+    skeleton (theory.md §7.5); level gravity leaves the water at rest. Without gravity the points
+    start stress-free at p = 0.
 
     Returns (solid_body, water_body), two non-dynamic Bodies to append to O.bodies.
     """
@@ -73,8 +80,9 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
         raise ValueError("positions must be a non-empty N×3 array [m], got shape %r" % (positions.shape,))
     if not spacing > 0:
         raise ValueError("spacing = %r m is outside the valid range (0, inf)" % (spacing,))
-    if gravity.shape != (3,) or gravity[0] != 0 or gravity[1] != 0 or gravity[2] > 0:
-        raise ValueError("gravity = %r m s⁻² must point along −z (or be zero) for a geostatic start" % (gravity.tolist(),))
+    if gravity.shape != (3,) or not np.isfinite(gravity).all() or gravity[2] > 0 or (gravity[2] == 0 and gravity.any()):
+        raise ValueError("gravity = %r m s⁻² is outside the valid range: zero, or with a downward z component (b_z < 0) for a "
+                         "geostatic start" % (gravity.tolist(),))
     count = len(positions)
     n0 = soil.porosity
     volume = np.full(count, spacing ** 3)
@@ -99,6 +107,11 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
         k0 = soil.poissonRatio / (1 - soil.poissonRatio) if lateral_earth_pressure is None else float(lateral_earth_pressure)
         stress[:, 0, 0] = stress[:, 1, 1] = k0 * vertical
         stress[:, 2, 2] = vertical
+        # an infinite slope: the downslope weight of the mixture in the skeleton's shear
+        for axis in (0, 1):
+            stress[:, axis, 2] = stress[:, 2, axis] = rho_sat * gravity[axis] * (surface - z)
+        water_velocity = np.zeros((count, 3))
+        water_velocity[:, :2] = soil.intrinsicPermeability / water.viscosity * rho_w * gravity[:2] / n0  # Darcy, slope-parallel
 
     solid = _w.MpmSolidPoints(pos=positions)
     solid.mass = (1 - n0) * soil.density * volume
@@ -115,6 +128,8 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
     fluid.halfLength = half
     fluid.porosity = np.full(count, n0)
     fluid.porePressure = pore_pressure
+    if g > 0:
+        fluid.vel = water_velocity
 
     bodies = []
     for shape, material in ((solid, soil), (fluid, water)):
@@ -122,3 +137,27 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
         body.dynamic = False  # the MPM engine moves the points, not NewtonIntegrator
         bodies.append(body)
     return tuple(bodies)
+
+
+def sudden_uniaxial_load(solid_body, water_body, soil, water, load):
+    """Add to a saturated block the undrained response to a vertical load `load` q [Pa] (compressive,
+    > 0) applied in one step under uniaxial strain (an oedometer): the water takes p0 = q B with
+    B = (Kw/n) / (E_oed + Kw/n) (analytical.undrained_pressure_ratio), the skeleton the rest,
+    Δσ′_zz = −(q − p0), Δσ′_xx = Δσ′_yy = ν/(1 − ν) Δσ′_zz. The bodies are those of saturated_block
+    (points at the same positions). Returns p0 [Pa]. The load itself still has to be applied
+    (e.g. extForce on the top points)."""
+    from . import analytical
+    if not (np.isfinite(load) and load > 0):
+        raise ValueError("load = %r Pa is outside the valid range (0, inf)" % (load,))
+    solid, fluid = solid_body.shape, water_body.shape
+    if solid.count != fluid.count:
+        raise ValueError("sudden_uniaxial_load needs the solid and water points of one saturated block (%d and %d points)" % (solid.count, fluid.count))
+    p0 = load * analytical.undrained_pressure_ratio(soil.youngModulus, soil.poissonRatio, soil.porosity, water.bulkModulus)
+    increment = -(load - p0)
+    stress = solid.stress
+    stress[:, 2, 2] += increment
+    stress[:, 0, 0] += soil.poissonRatio / (1 - soil.poissonRatio) * increment
+    stress[:, 1, 1] += soil.poissonRatio / (1 - soil.poissonRatio) * increment
+    solid.stress = stress
+    fluid.porePressure = fluid.porePressure + p0
+    return p0

@@ -93,7 +93,7 @@ def test_saturated_block_geostatic_state():
     assert np.allclose(s.halfLength, 0.025)
     with pytest.raises(ValueError, match="whole, positive number of cells"):
         yade_mpm.saturated_block((0, 0, 0), (0.15, 0.1, 1.0), 0.1, soil, water)
-    with pytest.raises(ValueError, match="must point along −z"):
+    with pytest.raises(ValueError, match=r"gravity = \[1.0, 0.0, 0.0\] m s⁻² is outside the valid range: zero, or with a downward z component"):
         yade_mpm.saturated_block((0, 0, 0), (0.1, 0.1, 1.0), 0.1, soil, water, gravity=(1, 0, 0))
 
 
@@ -171,3 +171,54 @@ def test_bad_point_arrays_are_named_as_python_spells_them(field, index, value, m
     with pytest.raises(ValueError, match=message):
         O.step()
     assert O.engines[0].stepsDone == 0 and O.iter == 0
+
+
+def test_saturated_block_under_a_tilted_gravity_is_an_infinite_slope_at_rest():
+    """Issue 17 item 15: a tilted gravity makes the block an infinite slope (z its normal): p = ρw g
+    cos β d, σ′_zz = −γ′ cos β d, the skeleton carrying the mixture's downslope weight in shear,
+    σ′_xz = γsat sin β d, and the water seeping parallel to the slope at Darcy's rate. Periodic along
+    the slope on a fixed base, that state is an equilibrium: the skeleton stays at rest and the
+    pressure unchanged (elastic soil, β = 15°)."""
+    g, beta, height, cell = 9.81, np.radians(15), 0.2, 0.05
+    gravity = (g * np.sin(beta), 0.0, -g * np.cos(beta))
+    soil = w.MpmSoilMat(density=2650, porosity=0.4, youngModulus=10e6, poissonRatio=0.3, intrinsicPermeability=1e-9)
+    water = w.MpmWaterMat(density=1000, bulkModulus=2.2e8)
+    O.materials.append([soil, water])
+    solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (0.15, cell, height), cell, soil, water, points_per_cell=2, gravity=gravity)
+    s, f = solid_body.shape, water_body.shape
+    depth = height - s.pos[:, 2]
+    rho_sat = 0.6 * 2650 + 0.4 * 1000
+    assert np.allclose(f.porePressure, 1000 * g * np.cos(beta) * depth, rtol=1e-14)
+    assert np.allclose(s.stress[:, 2, 2], -(rho_sat - 1000) * g * np.cos(beta) * depth, rtol=1e-14)
+    assert np.allclose(s.stress[:, 0, 2], rho_sat * g * np.sin(beta) * depth, rtol=1e-14)
+    assert np.allclose(s.stress[:, 2, 0], s.stress[:, 0, 2])
+    darcy = 1e-9 / 1e-3 * 1000 * g * np.sin(beta)  # κ/μw ρw g sin β [m/s]
+    assert np.allclose(f.vel[:, 0] * 0.4, darcy, rtol=1e-14) and not f.vel[:, 1:].any()
+    O.bodies.append([solid_body, water_body])
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm", gravity=gravity, domainMin=(0, 0, 0), domainMax=(0.15, cell, height + 2 * cell),
+                                     cellSize=cell, periodic=(True, False, False), freeSurfaceThreshold=0.5,
+                                     solidWalls=("free", "free", "slip", "slip", "fixed", "free"),
+                                     waterWalls=("free", "free", "impermeable", "impermeable", "impermeable", "free"))]
+    p0 = f.porePressure.copy()
+    O.dt = 1e-3
+    O.run(50, True)
+    assert np.abs(s.vel).max() < 1e-6  # at rest (an unbalanced start moves it by mm/s)
+    assert np.abs(f.porePressure - p0).max() < 1e-3 * 1000 * g * height
+
+
+def test_sudden_uniaxial_load_gives_the_undrained_start():
+    """Issue 17 item 15: the undrained response to a load q in one step under uniaxial strain: the
+    water takes p0 = q (Kw/n)/(E_oed + Kw/n) (Skempton's B of a confined sample), the skeleton the
+    rest, so the total vertical stress σ′_zz − p is −q everywhere, and K0 = ν/(1−ν) laterally."""
+    soil = w.MpmSoilMat(youngModulus=10e6, poissonRatio=0.3, porosity=0.3)
+    water = w.MpmWaterMat(bulkModulus=2.2e8)
+    solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (0.1, 0.1, 0.5), 0.1, soil, water)
+    q = 10e3
+    p0 = yade_mpm.builders.sudden_uniaxial_load(solid_body, water_body, soil, water, q)
+    e_oed = 10e6 * 0.7 / (1.3 * 0.4)
+    assert p0 == pytest.approx(q * (2.2e8 / 0.3) / (e_oed + 2.2e8 / 0.3), rel=1e-14)
+    s, f = solid_body.shape, water_body.shape
+    assert np.allclose(s.stress[:, 2, 2] - f.porePressure, -q, rtol=1e-14)
+    assert np.allclose(s.stress[:, 0, 0], 0.3 / 0.7 * s.stress[:, 2, 2], rtol=1e-14)
+    with pytest.raises(ValueError, match=r"load = -1.0 Pa is outside the valid range \(0, inf\)"):
+        yade_mpm.builders.sudden_uniaxial_load(solid_body, water_body, soil, water, -1.0)
