@@ -21,6 +21,7 @@ void BoundaryConditions::requireFreePeriodicFaces() const
 		                      : w.drainedPressure != noWall.drainedPressure ? "a drained pressure"
 		                      : w.friction != noWall.friction ? "wall friction"
 		                      : w.waterTable != noWall.waterTable ? "a water table"
+		                      : !w.traction.isZero()                ? "a face traction"
 		                                                          : nullptr;
 		if (condition)
 			throw InvalidParameter(std::string("face ") + faceName(f) + " lies across the periodic axis " + axisName(f / 2) + " but carries " + condition +
@@ -89,6 +90,27 @@ void forEachDrainedFaceTraction(const GridGeometry& grid, const BoundaryConditio
 				centroid[a1] += centroidShift(a1, j);
 				centroid[a2] += centroidShift(a2, k);
 				apply(I, wall.drainedPressureAt(centroid, gravity, waterDensity) * area * inward);
+			}
+	}
+}
+
+void addFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, Real solidMassTolerance, GridFields& fields)
+{
+	for (int face = 0; face < faceCount; ++face) {
+		const WallConditions& wall = bcs.walls[face];
+		const int             axis = face / 2, a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+		if (wall.traction.isZero() || grid.periodic[axis]) continue;
+		const int plane = face % 2 == 1 ? grid.upperWallNode[axis] : grid.wallNode[axis];
+		for (int j = 0; j < grid.nodes[a1]; ++j)
+			for (int k = 0; k < grid.nodes[a2]; ++k) {
+				const Real area = grid.inDomainSupport(a1, j) * grid.inDomainSupport(a2, k); // ∫ N dA over the face
+				if (area == 0) continue;
+				int idx[3];
+				idx[axis]           = plane;
+				idx[a1]             = j;
+				idx[a2]             = k;
+				const std::size_t I = grid.index(idx[0], idx[1], idx[2]);
+				if (fields.solid[I].mass > solidMassTolerance) fields.solid[I].mixtureForce += area * wall.traction;
 			}
 	}
 }

@@ -38,6 +38,9 @@ struct WallConditions {
 	// Drained faces only: water flowing in through the face is supplied as new water points
 	// (theory.md §2.5); without it the face holds p̄ but no water enters.
 	bool inflow = false;
+	// Traction t [Pa] on the mixture at the face (theory.md eq. 2.8), a load on the soil surface that
+	// lies on the face: ∮ N t dA on the face's nodes; components the solid wall holds go to it.
+	Vec3 traction = Vec3::Zero();
 
 	// Whether x lies below the water table (always, without a table or without gravity).
 	bool belowWaterTable(const Vec3& x, const Vec3& gravity) const
@@ -92,6 +95,10 @@ void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions&
 // The same tractions −∮ N p̄ n̂ dA per wall-plane node carrying water, handed to `apply(node, traction [N])`.
 void forEachDrainedFaceTraction(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, Real waterMassTolerance,
                                 const GridFields& fields, const std::function<void(std::size_t, const Vec3&)>& apply);
+
+// The face tractions (theory.md eq. 2.8): ∮ N t dA added to the mixture force of each face node that
+// carries solid.
+void addFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, Real solidMassTolerance, GridFields& fields);
 
 // Hold the pore pressure of water points at Drained faces (theory.md §2, eq. 2.1).
 void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, WaterPointSet& points);

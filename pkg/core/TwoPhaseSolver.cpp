@@ -278,6 +278,7 @@ template <class Kernel> void TwoPhaseSolver::mapPointsToGrid(bool wet)
 	{
 		StageTimer t(stageSeconds_, Stage::MapSolidToGrid);
 		mapSolidToGrid<Kernel>(grid_, solids_, wet ? &water_ : nullptr, g, fields_, workspace_);
+		addFaceTractions(grid_, domain_.boundaries, solidMassTolerance_, fields_); // eq. 2.8
 		if (wet) computeNodalPorosity(fields_);
 	}
 	if (!wet) return;
@@ -475,6 +476,7 @@ void TwoPhaseSolver::updateDrainedValues(const BoundaryConditions& boundaries)
 	for (int f = 0; f < faceCount; ++f) {
 		domain_.boundaries.walls[f].drainedPressure = boundaries.walls[f].drainedPressure;
 		domain_.boundaries.walls[f].waterTable      = boundaries.walls[f].waterTable;
+		domain_.boundaries.walls[f].traction        = boundaries.walls[f].traction;
 	}
 }
 

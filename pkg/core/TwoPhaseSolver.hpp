@@ -99,8 +99,8 @@ public:
 	long                                                stepCount() const { return steps_; }
 	Real                                                removedWaterMass() const { return removedWaterMass_; } // total, all sets [kg]
 	Real                                                injectedWaterMass() const { return injectedWaterMass_; } // through inflow faces [kg]
-	// Replace the values held on drained faces (p̄ and water table, e.g. a rising head) without
-	// rebuilding the solver; the kinds of the walls must stay as they were built.
+	// Replace the values held on the faces (p̄, water table and traction, e.g. a rising head or a load
+	// ramp) without rebuilding the solver; the kinds of the walls must stay as they were built.
 	void updateDrainedValues(const BoundaryConditions& boundaries);
 	const std::array<double, static_cast<int>(Stage::Count)>& stageSeconds() const { return stageSeconds_; }
 	const GridGeometry&                                 grid() const { return grid_; }

@@ -63,6 +63,12 @@ mpm::Domain MpmTwoPhaseEngine::domain() const
 		wall.solid           = parseOption("solidWalls[" + std::string(mpm::faceName(f)) + "]", solidWalls[f], solidWallOptions);
 		wall.water           = parseOption("waterWalls[" + std::string(mpm::faceName(f)) + "]", waterWalls[f], waterWallOptions);
 		wall.drainedPressure = drainedPressure[f];
+		wall.traction        = faceTraction[f];
+		if (!wall.traction.allFinite()) {
+			std::ostringstream value;
+			value << "(" << wall.traction[0] << ", " << wall.traction[1] << ", " << wall.traction[2] << ")";
+			mpm::throwOutOfRange("faceTraction[" + std::string(mpm::faceName(f)) + "]", value.str(), "Pa", "of finite vectors");
+		}
 		wall.friction        = wallFriction[f];
 		if (!(wall.friction >= 0 && std::isfinite(wall.friction))) mpm::throwOutOfRange("wallFriction[" + std::string(mpm::faceName(f)) + "]", wall.friction, "", "[0, inf)");
 		wall.waterTable      = drainedWaterTable[f];
@@ -259,6 +265,19 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		fixedListAttr("wallFriction", &E::wallFriction, 6, "Coulomb friction coefficient μ = tan δ per 'frictional' face [-], ≥ 0"),
 		fixedListAttr("waterWalls", &E::waterWalls, 6, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
 		fixedListAttr("drainedPressure", &E::drainedPressure, 6, "Uniform part of the pore pressure p̄ held on each 'drained' face [Pa]"),
+		AttrSpec<E> { "faceTraction",
+		              "Traction t per face (xMin, xMax, yMin, yMax, zMin, zMax) on the mixture, e.g. (0, 0, -q) on zMax for a surface load q on a soil whose top lies on that face, integrated as a boundary traction ∮ N t dA over the face (theory.md eq. 2.8); components a solid wall holds go to the wall; changed values apply in place [Pa]",
+		              [](const E& e) {
+			              py::list l;
+			              for (const auto& t : e.faceTraction) l.append(t);
+			              return py::object(py::tuple(l));
+		              },
+		              [](E& e, const py::object& v) {
+			              if (py::len(v) != 6) raisePython(PyExc_ValueError, "faceTraction needs 6 vectors (xMin, xMax, yMin, yMax, zMin, zMax) [Pa]");
+			              std::vector<yade::Vector3r> t;
+			              for (long i = 0; i < 6; ++i) t.push_back(toVector3("faceTraction", v[i]));
+			              e.faceTraction = t;
+		              } },
 		AttrSpec<E> { "waterSinks", "Boxes in which water points are removed (outflow, e.g. a filtering cloth), as a list of (lower, upper) corner pairs [m]",
 		              [](const E& e) {
 			              py::list l;
@@ -327,6 +346,7 @@ template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned
 	ar& BOOST_SERIALIZATION_NVP(solidWalls);
 	ar& BOOST_SERIALIZATION_NVP(waterWalls);
 	ar& BOOST_SERIALIZATION_NVP(drainedPressure);
+	serializeFlat(ar, "faceTraction", faceTraction);
 	ar& BOOST_SERIALIZATION_NVP(wallFriction);
 	ar& BOOST_SERIALIZATION_NVP(drainedWaterTable);
 	serializeFlat(ar, "waterSinks", waterSinks);

@@ -35,6 +35,7 @@ public:
 	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed | frictional
 	std::vector<std::string> waterWalls { 6, "free" };      // free | impermeable | drained
 	std::vector<yade::Real>  drainedPressure = std::vector<yade::Real>(6, 0.0); // p̄ per face [Pa]
+	std::vector<yade::Vector3r> faceTraction = std::vector<yade::Vector3r>(6, yade::Vector3r::Zero()); // t per face [Pa]
 	std::vector<yade::Real>  wallFriction    = std::vector<yade::Real>(6, 0.0); // μ per 'frictional' face [-]
 	std::vector<yade::Vector3r> waterSinks;             // (lower, upper) corner pairs of sink boxes [m]
 	bool                        removeWaterLeavingGrid = true; // water leaving the grid is removed (else: stop)

@@ -222,3 +222,14 @@ def test_sudden_uniaxial_load_gives_the_undrained_start():
     assert np.allclose(s.stress[:, 0, 0], 0.3 / 0.7 * s.stress[:, 2, 2], rtol=1e-14)
     with pytest.raises(ValueError, match=r"load = -1.0 Pa is outside the valid range \(0, inf\)"):
         yade_mpm.builders.sudden_uniaxial_load(solid_body, water_body, soil, water, -1.0)
+
+
+def test_face_traction_is_a_per_face_vector_in_pascal():
+    """faceTraction: six vectors (xMin..zMax) [Pa]; a non-finite component is refused naming the
+    face; a change applies to a running solver in place (a load ramp needs no rebuild)."""
+    engine = w.MpmTwoPhaseEngine(faceTraction=[(0, 0, 0)] * 5 + [(0, 0, -1e4)])
+    assert tuple(engine.faceTraction[5]) == (0, 0, -1e4)
+    with pytest.raises(ValueError, match=r"faceTraction\[zMax\] = \(0, 0, nan\) Pa is outside the valid range of finite vectors"):
+        engine.faceTraction = [(0, 0, 0)] * 5 + [(0, 0, float("nan"))]
+    with pytest.raises(ValueError, match=r"faceTraction needs 6 vectors"):
+        engine.faceTraction = [(0, 0, 0)] * 5
