@@ -69,6 +69,7 @@ namespace {
 			out["bodyId"]            = yade::abi::idOf(body);
 			out["bodyShapeIsShape"]  = yade::abi::shapeOf(body).get() == shape.get();
 			out["bodyMaterialIsMat"] = yade::abi::materialOf(body).get() == material.get();
+			out["blockedDOFs"]       = yade::abi::blockedDofsOf(body);
 		}
 		return out;
 	}

@@ -124,6 +124,7 @@ void MpmTwoPhaseEngine::action()
 	}
 
 	refuseSecondEngine();
+	refuseDynamicPointBodies();
 	// the recorders' files are checked before anything advances (a recorder runs after this engine)
 	for (const auto& engine : yade::abi::engines(scene))
 		if (const auto* recorder = dynamic_cast<const MpmHdf5Recorder*>(engine.get()); recorder && !recorder->dead && !recorder->started())
@@ -191,6 +192,24 @@ void MpmTwoPhaseEngine::action()
 	lastIter         = yade::abi::iter(scene);
 	mpmTime += dt;
 	++stepsDone;
+}
+
+void MpmTwoPhaseEngine::refuseDynamicPointBodies() const
+{
+	std::string integrator;
+	for (const auto& engine : yade::abi::engines(scene))
+		if (engine && !engine->dead && engine->getClassName() == "NewtonIntegrator") integrator = engine->label.empty() ? "a NewtonIntegrator" : "NewtonIntegrator '" + engine->label + "'";
+	if (integrator.empty()) return;
+	for (const auto& body : yade::abi::bodies(scene)) {
+		if (!body) continue;
+		const auto& shape = yade::abi::shapeOf(body.get());
+		if (!dynamic_cast<MpmSolidPoints*>(shape.get()) && !dynamic_cast<MpmWaterPoints*>(shape.get())) continue;
+		if (yade::abi::blockedDofsOf(body.get()) == yade::abi::allDofsBlocked) continue;
+		const std::string where = "O.bodies[" + std::to_string(yade::abi::idOf(body.get())) + "]";
+		throw mpm::InvalidParameter(where + ".dynamic = True with " + integrator + " in O.engines: it would move the " + shape->getClassName() +
+		                            " body as a rigid particle of zero mass (NaN positions); MPM bodies are moved by MpmTwoPhaseEngine only: set " + where +
+		                            ".dynamic = False (yade_mpm.saturated_block does)");
+	}
 }
 
 void MpmTwoPhaseEngine::refuseSecondEngine() const

@@ -79,6 +79,8 @@ private:
 	Structure structure() const;
 	// Refuses a scene whose O.engines holds another active MpmTwoPhaseEngine (issue 17 item 2).
 	void refuseSecondEngine() const;
+	// Refuses MPM bodies left dynamic while a NewtonIntegrator runs (issue 17 item 4).
+	void refuseDynamicPointBodies() const;
 
 	std::unique_ptr<mpm::TwoPhaseSolver> solver_;  // not serialized: rebuilt on first action()
 	Structure                            builtFor_ {};

@@ -233,6 +233,11 @@ namespace abi {
 	constexpr std::size_t bodyId                 = 0x18;  // int
 	constexpr std::size_t bodyMaterial           = 0x28;  // shared_ptr<Material>
 	constexpr std::size_t bodyShape              = 0x48;  // shared_ptr<Shape>
+	constexpr std::size_t bodyState              = 0x38;  // shared_ptr<State>
+	// State (0x140): se3 @0x58 (56 B), vel @0x90, mass @0xa8, angVel @0xb0, angMom @0xc8, inertia
+	// @0xe0, refPos @0xf8, refOri @0x110 (32 B), then blockedDOFs, isDamped, densityScaling
+	constexpr std::size_t stateBlockedDofs       = 0x130; // unsigned; DOF_ALL = 63 is "not dynamic"
+	constexpr unsigned    allDofsBlocked         = 63;
 
 	template <class T> inline T& at(const void* base, std::size_t offset)
 	{
@@ -250,6 +255,12 @@ namespace abi {
 	inline const boost::shared_ptr<Shape>&    shapeOf(const Body* b) { return at<boost::shared_ptr<Shape>>(b, bodyShape); }
 	inline const boost::shared_ptr<Material>& materialOf(const Body* b) { return at<boost::shared_ptr<Material>>(b, bodyMaterial); }
 	inline int                                idOf(const Body* b) { return at<int>(b, bodyId); }
+	// Body::isDynamic(): not every degree of freedom blocked
+	inline unsigned blockedDofsOf(const Body* b)
+	{
+		const auto& state = at<boost::shared_ptr<State>>(b, bodyState);
+		return state ? at<unsigned>(state.get(), stateBlockedDofs) : allDofsBlocked;
+	}
 } // namespace abi
 
 // The layout facts, checked at compile time.

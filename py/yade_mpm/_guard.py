@@ -44,7 +44,9 @@ def self_test(module, wrapper, omega):
     # An erased body leaves an empty slot in O.bodies, so the Body offsets are checked only on an
     # empty scene (the usual place of an import), which is cleared again afterwards.
     check_body = len(omega.bodies) == 0
-    body_id = omega.bodies.append(wrapper.Body(shape=shape, material=material)) if check_body else -1
+    body = wrapper.Body(shape=shape, material=material)
+    body.state.blockedDOFs = "xyZ"  # bits 1 + 2 + 32: read back at the mirrored State offset
+    body_id = omega.bodies.append(body) if check_body else -1
     try:
         omega.dt = sentinel_dt
         got = module.readMirroredValues(engine, shape, material, body_id)
@@ -59,7 +61,7 @@ def self_test(module, wrapper, omega):
         "density": 1234.5, "materialLabel": "mpm_abi_sentinel_material",
     }
     if check_body:
-        expected.update(bodyId=body_id, bodyShapeIsShape=True, bodyMaterialIsMat=True)
+        expected.update(bodyId=body_id, bodyShapeIsShape=True, bodyMaterialIsMat=True, blockedDOFs=35)
     wrong = ["%s: set %r, read %r" % (k, v, got.get(k)) for k, v in expected.items() if got.get(k) != v]
     if wrong:
         raise YadeAbiMismatch("yade_mpm's self-test read wrong values at the mirrored YADE offsets ("

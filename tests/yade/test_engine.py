@@ -233,3 +233,26 @@ def test_face_traction_is_a_per_face_vector_in_pascal():
         engine.faceTraction = [(0, 0, 0)] * 5 + [(0, 0, float("nan"))]
     with pytest.raises(ValueError, match=r"faceTraction needs 6 vectors"):
         engine.faceTraction = [(0, 0, 0)] * 5
+
+
+def test_dynamic_point_bodies_with_a_newton_integrator_are_refused():
+    """Issue 17 item 4: an MPM body left dynamic=True (YADE's default for a new Body) while a
+    NewtonIntegrator runs would be moved as a rigid particle of zero mass (its state.pos became NaN):
+    refused at the first step naming the body, nothing advanced; non-dynamic, it runs."""
+    soil = w.MpmSoilMat()
+    O.materials.append(soil)
+    solid = w.MpmSolidPoints(pos=[[0.025, 0.025, 0.025]])
+    solid.mass, solid.volume, solid.initialVolume = [1.0], [1.25e-4], [1.25e-4]
+    solid.halfLength = solid.initialHalfLength = [[0.0125] * 3]
+    solid.porosity = [0.4]
+    body = w.Body(shape=solid, material=soil)  # dynamic by default
+    O.bodies.append(body)
+    O.engines = [w.ForceResetter(), w.MpmTwoPhaseEngine(label="mpm", domainMin=(0, 0, 0), domainMax=(0.05, 0.05, 0.05), cellSize=0.05),
+                 w.NewtonIntegrator(label="newton")]
+    O.dt = 1e-4
+    with pytest.raises(ValueError, match=r"O.bodies\[0\].dynamic = True with NewtonIntegrator 'newton' in O.engines: .*set O.bodies\[0\].dynamic = False"):
+        O.step()
+    assert O.engines[1].stepsDone == 0 and O.iter == 0
+    body.dynamic = False
+    O.step()
+    assert O.engines[1].stepsDone == 1 and np.isfinite(np.array(body.state.pos)).all()
