@@ -288,7 +288,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		              "Traction t per face (xMin, xMax, yMin, yMax, zMin, zMax) on the mixture, e.g. (0, 0, -q) on zMax for a surface load q on a soil whose top lies on that face, integrated as a boundary traction ∮ N t dA over the face (theory.md eq. 2.8); components a solid wall holds go to the wall; changed values apply in place [Pa]",
 		              [](const E& e) {
 			              py::list l;
-			              for (const auto& t : e.faceTraction) l.append(t);
+			              for (const auto& t : e.faceTraction) l.append(py::make_tuple(t[0], t[1], t[2])); // plain tuples, as the other per-face lists
 			              return py::object(py::tuple(l));
 		              },
 		              [](E& e, const py::object& v) {
