@@ -4,6 +4,7 @@
 #include "Grid.hpp"
 #include "PointSets.hpp"
 
+#include <array>
 #include <functional>
 #include <string>
 
@@ -61,6 +62,26 @@ NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& 
 	return c;
 }
 
+namespace {
+	// Every node of `face`'s plane whose support reaches into the domain, with ∫ N dA over the face
+	// (h² inside, halved per domain edge) and its grid indices.
+	template <class F> void forEachFaceNode(const GridGeometry& grid, int face, F&& visit)
+	{
+		const int axis = face / 2, a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+		const int plane = face % 2 == 1 ? grid.upperWallNode[axis] : grid.wallNode[axis];
+		for (int j = 0; j < grid.nodes[a1]; ++j)
+			for (int k = 0; k < grid.nodes[a2]; ++k) {
+				const Real area = grid.inDomainSupport(a1, j) * grid.inDomainSupport(a2, k);
+				if (area == 0) continue;
+				std::array<int, 3> idx;
+				idx[axis] = plane;
+				idx[a1]   = j;
+				idx[a2]   = k;
+				visit(grid.index(idx[0], idx[1], idx[2]), area, idx);
+			}
+	}
+} // namespace
+
 void forEachDrainedFaceTraction(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, Real waterMassTolerance,
                                  const GridFields& fields, const std::function<void(std::size_t, const Vec3&)>& apply)
 {
@@ -70,27 +91,18 @@ void forEachDrainedFaceTraction(const GridGeometry& grid, const BoundaryConditio
 		if (wall.water != WaterWall::Drained || (wall.drainedPressure == 0 && wall.waterTable == -std::numeric_limits<Real>::infinity())) continue;
 		const int  axis = face / 2, a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
 		const bool upperFace = face % 2 == 1;
-		const int  plane     = upperFace ? grid.upperWallNode[axis] : grid.wallNode[axis];
 		Vec3       inward    = Vec3::Zero();
 		inward[axis]         = upperFace ? -1 : 1;
 		// centroid of N on the face, where a linearly varying p̄ gives ∫ p̄ N dA = p̄(centroid) ∫ N dA:
 		// the node itself inside, h/3 inwards on an edge (the tent is one-sided there)
 		auto centroidShift = [&](int d, int i) { return grid.periodic[d] ? 0.0 : i == grid.wallNode[d] ? h / 3 : (i == grid.upperWallNode[d] ? -h / 3 : 0.0); };
-		for (int j = 0; j < grid.nodes[a1]; ++j)
-			for (int k = 0; k < grid.nodes[a2]; ++k) {
-				const Real area = grid.inDomainSupport(a1, j) * grid.inDomainSupport(a2, k); // ∫ N dA over the face
-				if (area == 0) continue;
-				int idx[3];
-				idx[axis] = plane;
-				idx[a1]   = j;
-				idx[a2]   = k;
-				const std::size_t I = grid.index(idx[0], idx[1], idx[2]);
-				if (!(fields.water[I].mass > waterMassTolerance)) continue;
-				Vec3 centroid = grid.nodePosition(idx[0], idx[1], idx[2]);
-				centroid[a1] += centroidShift(a1, j);
-				centroid[a2] += centroidShift(a2, k);
-				apply(I, wall.drainedPressureAt(centroid, gravity, waterDensity) * area * inward);
-			}
+		forEachFaceNode(grid, face, [&](std::size_t I, Real area, const std::array<int, 3>& idx) {
+			if (!(fields.water[I].mass > waterMassTolerance)) return;
+			Vec3 centroid = grid.nodePosition(idx[0], idx[1], idx[2]);
+			centroid[a1] += centroidShift(a1, idx[a1]);
+			centroid[a2] += centroidShift(a2, idx[a2]);
+			apply(I, wall.drainedPressureAt(centroid, gravity, waterDensity) * area * inward);
+		});
 	}
 }
 
@@ -98,20 +110,10 @@ void addFaceTractions(const GridGeometry& grid, const BoundaryConditions& bcs, R
 {
 	for (int face = 0; face < faceCount; ++face) {
 		const WallConditions& wall = bcs.walls[face];
-		const int             axis = face / 2, a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-		if (wall.traction.isZero() || grid.periodic[axis]) continue;
-		const int plane = face % 2 == 1 ? grid.upperWallNode[axis] : grid.wallNode[axis];
-		for (int j = 0; j < grid.nodes[a1]; ++j)
-			for (int k = 0; k < grid.nodes[a2]; ++k) {
-				const Real area = grid.inDomainSupport(a1, j) * grid.inDomainSupport(a2, k); // ∫ N dA over the face
-				if (area == 0) continue;
-				int idx[3];
-				idx[axis]           = plane;
-				idx[a1]             = j;
-				idx[a2]             = k;
-				const std::size_t I = grid.index(idx[0], idx[1], idx[2]);
-				if (fields.solid[I].mass > solidMassTolerance) fields.solid[I].mixtureForce += area * wall.traction;
-			}
+		if (wall.traction.isZero() || grid.periodic[face / 2]) continue;
+		forEachFaceNode(grid, face, [&](std::size_t I, Real area, const std::array<int, 3>&) {
+			if (fields.solid[I].mass > solidMassTolerance) fields.solid[I].mixtureForce += area * wall.traction;
+		});
 	}
 }
 

@@ -14,6 +14,20 @@ public:
 	using std::invalid_argument::invalid_argument;
 };
 
+// A step dt that would need more sub-steps than SolverSettings::maxSubSteps; thrown by advance()
+// before any work, with what a caller needs to phrase it in its own names.
+class TooManySubSteps : public InvalidParameter {
+public:
+	TooManySubSteps(const std::string& what, long subSteps, double critical)
+	        : InvalidParameter(what)
+	        , needed(subSteps)
+	        , criticalStep(critical)
+	{
+	}
+	long   needed;       // sub-steps dt would take [-]
+	double criticalStep; // the critical step they are bounded by, before timeStepFactor [s]
+};
+
 // A simulation that went unstable (non-finite or runaway state); thrown at the step it happens.
 class InstabilityError : public std::runtime_error {
 public:

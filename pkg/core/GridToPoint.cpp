@@ -14,7 +14,7 @@ namespace stages {
 
 	template <class Kernel>
 	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
-	                           const std::vector<Real>& retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt, Real flipBlend)
+	                           const std::vector<Real>* retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt, Real flipBlend)
 	{
 		const std::size_t count   = points.size();
 		long              invalid = -1;
@@ -23,11 +23,11 @@ namespace stages {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, points.position[p], points.halfLength[p], w);
 			Vec3 vNew = Vec3::Zero(), vOld = Vec3::Zero(), gained = Vec3::Zero();
-			Real kept = 0;
+			Real kept = retention ? 0 : 1;
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 				vNew += N * gridVelocityNew[I];
 				vOld += N * gridVelocity[I];
-				kept += N * retention[I];
+				if (retention) kept += N * (*retention)[I];
 				if (received) gained += N * (*received)[I];
 			});
 			// eq. 4.11 written as v̄ + α(v_p − Σ S v^n_I), the unresolved part damped by eq. 4.11b and
@@ -93,7 +93,7 @@ namespace stages {
 	}
 
 #define MPM_INSTANTIATE(K) \
-	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const std::vector<Real>&, const std::vector<Vec3>*, MaterialPointSet&, Real, Real); \
+	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const std::vector<Real>*, const std::vector<Vec3>*, MaterialPointSet&, Real, Real); \
 	template void scatterDragLoss<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Real>&, const MaterialPointSet&, Real, std::vector<Vec3>&, std::vector<std::vector<Vec3>>&); \
 	template long firstPointOutsideGrid<K>(const GridGeometry&, const MaterialPointSet&);
 

@@ -121,13 +121,14 @@ namespace stages {
 
 	// Step 7 (theory.md eqs. 4.11–4.11c): G2P with FLIP/PIC blend α; the part of the point velocity
 	// the grid does not carry is damped by the drag at the point, `retention` per node
-	// (dragRetention, interpolated), and the velocity `received` per node (null: none) is added;
+	// (dragRetention, interpolated; null: not damped), and the velocity `received` per node (null:
+	// none) is added;
 	// positions move with the new grid velocity. Returns the index of the first runaway point, or -1:
 	// one whose velocity is not finite or whose displacement in this step exceeds the cell size (a
 	// CFL violation that no stable explicit step produces).
 	template <class Kernel>
 	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
-	                           const std::vector<Real>& retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt,
+	                           const std::vector<Real>* retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt,
 	                           Real flipBlend);
 
 	// theory.md eq. 4.11b: per node, the factor 1/(1 + Δt Q_I/m_I) by which the implicit drag Q_I

@@ -202,12 +202,6 @@ TimeStepLimits TwoPhaseSolver::timeStepLimits(Real horizon) const
 	return limits;
 }
 
-long TwoPhaseSolver::subStepsFor(Real dt) const
-{
-	TimeStepLimits limits;
-	return subStepsFor(dt, limits);
-}
-
 long TwoPhaseSolver::subStepsFor(Real dt, TimeStepLimits& limits) const
 {
 	requireOpenRange("dt", dt, 0, inf, "s");
@@ -225,7 +219,7 @@ long TwoPhaseSolver::advance(Real dt)
 		std::ostringstream msg;
 		msg << "dt = " << dt << " s needs " << substeps << " sub-steps of timeStepFactor × critical step = " << settings_.timeStepFactor << " × "
 		    << lastLimits_.critical << " s, more than maxSubSteps = " << settings_.maxSubSteps;
-		throw InvalidParameter(msg.str());
+		throw TooManySubSteps(msg.str(), substeps, lastLimits_.critical);
 	}
 	for (long i = 0; i < substeps; ++i) {
 		try {
@@ -349,21 +343,21 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 				stages::scatterDragLoss<Kernel>(grid_, fields_.solidVelocity, solidRetention_, *s.points, settings_.flipBlend, solidDragLoss_, lossBuffers_);
 			for (const WaterPointSet* w : waters_)
 				stages::scatterDragLoss<Kernel>(grid_, fields_.waterVelocity, waterRetention_, *w, settings_.flipBlend, waterDragLoss_, lossBuffers_);
-			for (std::size_t I = 0; I < solidDragLoss_.size(); ++I) { // the loss of one phase is the gain of the other
+			// the loss of one phase is the gain of the other (a loss exists only where both carry mass)
+			const std::size_t nodes = solidDragLoss_.size();
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
+			for (std::size_t I = 0; I < nodes; ++I) {
 				const Vec3 toWater = solidDragLoss_[I], toSolid = waterDragLoss_[I];
-				solidDragLoss_[I]  = toSolid / (fields_.solid[I].mass > solidMassTolerance_ ? fields_.solid[I].mass : 1);
-				waterDragLoss_[I]  = toWater / (fields_.water[I].mass > waterMassTolerance_ ? fields_.water[I].mass : 1);
+				solidDragLoss_[I]  = solidRetention_[I] < 1 ? Vec3(toSolid / fields_.solid[I].mass) : Vec3::Zero();
+				waterDragLoss_[I]  = waterRetention_[I] < 1 ? Vec3(toWater / fields_.water[I].mass) : Vec3::Zero();
 			}
-		} else {
-			solidRetention_.assign(grid_.nodeCount(), 1);
-			waterRetention_.assign(grid_.nodeCount(), 1);
 		}
 		for (std::size_t s = 0; s < solids_.size(); ++s)
-			check(stages::updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, solidRetention_,
+			check(stages::updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, exchange ? &solidRetention_ : nullptr,
 			                                            exchange ? &solidDragLoss_ : nullptr, *solids_[s].points, dt, settings_.flipBlend),
 			      solids_[s].name, *solids_[s].points);
 		for (std::size_t w = 0; w < waters_.size(); ++w)
-			check(stages::updatePointKinematics<Kernel>(grid_, fields_.waterVelocity, fields_.waterVelocityNew, waterRetention_,
+			check(stages::updatePointKinematics<Kernel>(grid_, fields_.waterVelocity, fields_.waterVelocityNew, exchange ? &waterRetention_ : nullptr,
 			                                            exchange ? &waterDragLoss_ : nullptr, *waters_[w], dt, settings_.flipBlend),
 			      waterNames_[w], *waters_[w]);
 	}

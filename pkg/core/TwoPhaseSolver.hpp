@@ -88,11 +88,11 @@ public:
 	// the point and the quantity if the state stops being finite or a point leaves the grid.
 	void step(Real dt);
 	// Advance by dt in equal sub-steps no larger than timeStepFactor × critical; returns their number.
-	// The limits it used are kept in lastTimeStepLimits().
+	// The limits it used are kept in lastTimeStepLimits(). More than maxSubSteps: TooManySubSteps,
+	// nothing advanced.
 	long                  advance(Real dt);
 	// The sub-steps advance(dt) would take now (the critical step of the current state, theory.md §5,
-	// eq. 8.10), without advancing anything.
-	long                  subStepsFor(Real dt) const;
+	// eq. 8.10), with the limits they follow; advances nothing.
 	long                  subStepsFor(Real dt, TimeStepLimits& limits) const;
 	const TimeStepLimits& lastTimeStepLimits() const { return lastLimits_; }
 

@@ -123,12 +123,7 @@ void MpmTwoPhaseEngine::action()
 		builtFor_ = structure();
 	}
 
-	refuseSecondEngine();
-	refuseDynamicPointBodies();
-	// the recorders' files are checked before anything advances (a recorder runs after this engine)
-	for (const auto& engine : yade::abi::engines(scene))
-		if (const auto* recorder = dynamic_cast<const MpmHdf5Recorder*>(engine.get()); recorder && !recorder->dead && !recorder->started())
-			recorder->checkFile(&yade::abi::engines(scene));
+	const std::string integrator = checkOtherEngines();
 	std::vector<mpm::SolidSet>       solids;
 	std::vector<mpm::WaterPointSet*> waters;
 	std::vector<std::string>         waterNames;
@@ -138,15 +133,18 @@ void MpmTwoPhaseEngine::action()
 	std::map<const void*, int>       owner; // point-set shape → the first body that carries it
 	for (const auto& body : yade::abi::bodies(scene)) {
 		if (!body) continue; // erased body
-		const auto&       shape = yade::abi::shapeOf(body.get());
+		const auto& shape = yade::abi::shapeOf(body.get());
+		if (!dynamic_cast<MpmSolidPoints*>(shape.get()) && !dynamic_cast<MpmWaterPoints*>(shape.get())) continue;
 		const int         id    = yade::abi::idOf(body.get());
 		const std::string where = "O.bodies[" + std::to_string(id) + "]";
-		if (dynamic_cast<MpmSolidPoints*>(shape.get()) || dynamic_cast<MpmWaterPoints*>(shape.get())) {
-			const auto [first, fresh] = owner.emplace(shape.get(), id);
-			if (!fresh)
-				throw mpm::InvalidParameter("O.bodies[" + std::to_string(first->second) + "] and " + where + " share one " + shape->getClassName() +
-				                            " shape: its points would be advanced twice per step; give each body its own shape (e.g. a copy)");
-		}
+		const auto [first, fresh] = owner.emplace(shape.get(), id);
+		if (!fresh)
+			throw mpm::InvalidParameter("O.bodies[" + std::to_string(first->second) + "] and " + where + " share one " + shape->getClassName() +
+			                            " shape: its points would be advanced twice per step; give each body its own shape (e.g. a copy)");
+		if (!integrator.empty() && yade::abi::blockedDofsOf(body.get()) != yade::abi::allDofsBlocked)
+			throw mpm::InvalidParameter(where + ".dynamic = True with " + integrator + " in O.engines: it would move the " + shape->getClassName() +
+			                            " body as a rigid particle of zero mass (NaN positions); MPM bodies are moved by MpmTwoPhaseEngine only: set " + where +
+			                            ".dynamic = False (yade_mpm.saturated_block does)");
 		if (auto* s = dynamic_cast<MpmSolidPoints*>(shape.get())) {
 			auto* mat = dynamic_cast<MpmSoilMat*>(yade::abi::materialOf(body.get()).get());
 			if (!mat) throw mpm::InvalidParameter(where + " carries MpmSolidPoints but its material is not an MpmSoilMat");
@@ -165,17 +163,14 @@ void MpmTwoPhaseEngine::action()
 		}
 	}
 	solver_->setPoints(std::move(solids), std::move(waters), water, waterNames); // validates every point set
-	const long needed = solver_->subStepsFor(dt);
-	if (needed > maxSubSteps) {
-		const mpm::TimeStepLimits limits = solver_->timeStepLimits(dt);
-		std::ostringstream        msg;
-		msg << "O.dt = " << dt << " s needs " << needed << " sub-steps of timeStepFactor × criticalTimeStep = " << timeStepFactor << " × "
-		    << limits.critical << " s, more than maxSubSteps = " << maxSubSteps << ": lower O.dt (at most "
-		    << maxSubSteps * timeStepFactor * limits.critical << " s) or raise maxSubSteps (nothing was advanced)";
-		throw mpm::InvalidParameter(msg.str());
-	}
 	try {
 		subStepsLast = solver_->advance(dt);
+	} catch (const mpm::TooManySubSteps& e) {
+		std::ostringstream msg;
+		msg << "O.dt = " << dt << " s needs " << e.needed << " sub-steps of timeStepFactor × criticalTimeStep = " << timeStepFactor << " × "
+		    << e.criticalStep << " s, more than maxSubSteps = " << maxSubSteps << ": lower O.dt (at most " << maxSubSteps * timeStepFactor * e.criticalStep
+		    << " s) or raise maxSubSteps (nothing was advanced)";
+		throw mpm::InvalidParameter(msg.str());
 	} catch (const mpm::InstabilityError& e) {
 		std::ostringstream msg;
 		msg << "O.iter = " << yade::abi::iter(scene) << " (O.time = " << yade::abi::time(scene) << " s): " << e.what();
@@ -194,38 +189,27 @@ void MpmTwoPhaseEngine::action()
 	++stepsDone;
 }
 
-void MpmTwoPhaseEngine::refuseDynamicPointBodies() const
+std::string MpmTwoPhaseEngine::checkOtherEngines() const
 {
-	std::string integrator;
-	for (const auto& engine : yade::abi::engines(scene))
-		if (engine && !engine->dead && engine->getClassName() == "NewtonIntegrator") integrator = engine->label.empty() ? "a NewtonIntegrator" : "NewtonIntegrator '" + engine->label + "'";
-	if (integrator.empty()) return;
-	for (const auto& body : yade::abi::bodies(scene)) {
-		if (!body) continue;
-		const auto& shape = yade::abi::shapeOf(body.get());
-		if (!dynamic_cast<MpmSolidPoints*>(shape.get()) && !dynamic_cast<MpmWaterPoints*>(shape.get())) continue;
-		if (yade::abi::blockedDofsOf(body.get()) == yade::abi::allDofsBlocked) continue;
-		const std::string where = "O.bodies[" + std::to_string(yade::abi::idOf(body.get())) + "]";
-		throw mpm::InvalidParameter(where + ".dynamic = True with " + integrator + " in O.engines: it would move the " + shape->getClassName() +
-		                            " body as a rigid particle of zero mass (NaN positions); MPM bodies are moved by MpmTwoPhaseEngine only: set " + where +
-		                            ".dynamic = False (yade_mpm.saturated_block does)");
-	}
-}
-
-void MpmTwoPhaseEngine::refuseSecondEngine() const
-{
-	std::string found;
+	std::string found, integrator;
 	int         active = 0;
 	const auto& engines = yade::abi::engines(scene);
 	for (std::size_t i = 0; i < engines.size(); ++i) {
-		const auto* other = dynamic_cast<const MpmTwoPhaseEngine*>(engines[i].get());
-		if (!other || other->dead) continue;
-		++active;
-		found += (found.empty() ? "" : ", ") + std::string("O.engines[") + std::to_string(i) + "]" + (other->label.empty() ? "" : " (label '" + other->label + "')");
+		const yade::Engine* engine = engines[i].get();
+		if (!engine || engine->dead) continue;
+		if (dynamic_cast<const MpmTwoPhaseEngine*>(engine)) {
+			++active;
+			found += (found.empty() ? "" : ", ") + std::string("O.engines[") + std::to_string(i) + "]" + (engine->label.empty() ? "" : " (label '" + engine->label + "')");
+		} else if (const auto* recorder = dynamic_cast<const MpmHdf5Recorder*>(engine)) {
+			if (!recorder->started()) recorder->checkFile(&engines); // a recorder runs after this engine: checked before anything advances
+		} else if (engine->getClassName() == "NewtonIntegrator") {
+			integrator = engine->label.empty() ? "a NewtonIntegrator" : "NewtonIntegrator '" + engine->label + "'";
+		}
 	}
 	if (active > 1)
 		throw mpm::InvalidParameter("O.engines holds " + std::to_string(active) + " active MpmTwoPhaseEngines: " + found +
 		                            "; each advances every MPM body of the scene, so the points would move twice per step: keep one (or set dead=True on the others)");
+	return integrator;
 }
 
 MpmTwoPhaseEngine::Structure MpmTwoPhaseEngine::structure() const

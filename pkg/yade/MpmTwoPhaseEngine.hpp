@@ -77,10 +77,10 @@ private:
 	using Structure = std::tuple<std::string, yade::Real, yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, bool, yade::Real, bool,
 	                             std::vector<std::string>, std::vector<yade::Real>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>, std::vector<int>, long>;
 	Structure structure() const;
-	// Refuses a scene whose O.engines holds another active MpmTwoPhaseEngine (issue 17 item 2).
-	void refuseSecondEngine() const;
-	// Refuses MPM bodies left dynamic while a NewtonIntegrator runs (issue 17 item 4).
-	void refuseDynamicPointBodies() const;
+	// Before any work, over O.engines: refuses another active MpmTwoPhaseEngine (issue 17 item 2) and
+	// a recorder file that cannot or must not be written (item 5); returns how to name an active
+	// NewtonIntegrator ("" if none), under which MPM bodies must not be dynamic (item 4).
+	std::string checkOtherEngines() const;
 
 	std::unique_ptr<mpm::TwoPhaseSolver> solver_;  // not serialized: rebuilt on first action()
 	Structure                            builtFor_ {};

@@ -105,7 +105,6 @@ TEST(GridToParticle, LinearFieldIsInterpolatedExactly)
 	A << 0.3, -1.2, 0.5, 2.0, 0.1, -0.7, 0.4, 0.9, -0.2;
 	const Vec3 b(0.1, -0.2, 0.3);
 	std::vector<Vec3> field(box.grid.nodeCount()), zero(box.grid.nodeCount(), Vec3::Zero());
-	const std::vector<Real> ones(box.grid.nodeCount(), 1.0);
 	for (int k = 0; k < box.grid.nodes[2]; ++k)
 		for (int j = 0; j < box.grid.nodes[1]; ++j)
 			for (int i = 0; i < box.grid.nodes[0]; ++i) field[box.grid.index(i, j, k)] = A * box.grid.nodePosition(i, j, k) + b;
@@ -114,10 +113,10 @@ TEST(GridToParticle, LinearFieldIsInterpolatedExactly)
 		const auto        x0 = s.position;
 		std::vector<Mat3> L;
 		if (gimp) {
-			stages::updatePointKinematics<GimpKernel>(box.grid, zero, field, ones, nullptr, s, 1e-3, 0.0); // PIC: v_p = Σ S v_I
+			stages::updatePointKinematics<GimpKernel>(box.grid, zero, field, nullptr, nullptr, s, 1e-3, 0.0); // PIC: v_p = Σ S v_I
 			stages::computeVelocityGradients<GimpKernel>(box.grid, field, s, L);
 		} else {
-			stages::updatePointKinematics<LinearKernel>(box.grid, zero, field, ones, nullptr, s, 1e-3, 0.0);
+			stages::updatePointKinematics<LinearKernel>(box.grid, zero, field, nullptr, nullptr, s, 1e-3, 0.0);
 			stages::computeVelocityGradients<LinearKernel>(box.grid, field, s, L);
 		}
 		for (std::size_t p = 0; p < s.size(); ++p) {
@@ -151,7 +150,7 @@ TEST(GridToParticle, DragDampsOnlyTheVelocityTheGridDoesNotCarry)
 	const std::vector<Vec3> grid(box.grid.nodeCount(), uniform);
 	SolidPointSet           s = randomSolid(200, rng);
 	const auto              v0 = s.velocity;
-	stages::updatePointKinematics<GimpKernel>(box.grid, grid, grid, waterKept, nullptr, s, dt, 1.0); // FLIP
+	stages::updatePointKinematics<GimpKernel>(box.grid, grid, grid, &waterKept, nullptr, s, dt, 1.0); // FLIP
 	for (std::size_t p = 0; p < s.size(); ++p)
 		EXPECT_LT((s.velocity[p] - (uniform + waterKept[7] * (v0[p] - uniform))).norm(), 1e-13);
 	box.fields.solid[3].drag = 0; // no drag, no mass: nothing damped
