@@ -129,8 +129,7 @@ void addDrainedFaceTractions(const GridGeometry& grid, const BoundaryConditions&
 void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, WaterPointSet& points)
 {
 	const Vec3        lower = grid.lower(), upper = grid.upper();
-	const Real        tolerance = 1e-9 * grid.cellSize;
-	const std::size_t count     = points.size();
+	const std::size_t count = points.size();
 	for (int face = 0; face < faceCount; ++face) {
 		const WallConditions& wall = bcs.walls[face];
 		if (wall.water != WaterWall::Drained) continue;
@@ -138,9 +137,12 @@ void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, 
 		const bool upperFace = face % 2 == 1;
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
+			// A face point: its centre lies within two half-lengths (one point spacing) of the face or
+			// beyond it. The outer layer stays one after a settlement of round-off size and until it
+			// has moved half a spacing off; the next layer (three half-lengths in) never is one.
 			const Real x = points.position[p][axis], l = points.halfLength[p][axis];
-			const bool reaches = upperFace ? x + l >= upper[axis] - tolerance : x - l <= lower[axis] + tolerance;
-			if (reaches) points.porePressure[p] = wall.drainedPressureAt(points.position[p], gravity, waterDensity);
+			const bool facePoint = upperFace ? x >= upper[axis] - 2 * l : x <= lower[axis] + 2 * l;
+			if (facePoint) points.porePressure[p] = wall.drainedPressureAt(points.position[p], gravity, waterDensity);
 		}
 	}
 }

@@ -24,7 +24,7 @@ enum class WaterWall {
 	Free,        // no condition on the water (natural: zero pressure traction, weakly enforced)
 	Impermeable, // normal water velocity 0 (tangential water flow free)
 	Drained,     // water crosses freely; pore pressure held at drainedPressure on the water
-	             // points whose GIMP domain reaches the face or lies beyond it (theory.md §2)
+	             // points whose centre lies within one point spacing of the face (theory.md eq. 2.1)
 };
 
 struct WallConditions {

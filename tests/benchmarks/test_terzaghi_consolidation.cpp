@@ -209,6 +209,34 @@ TEST(FaceTraction, TheTopCellCarriesASurfaceLoadAndTheColumnSettlesAsTerzaghi)
 	EXPECT_LT(std::abs(fine), 0.5 * std::abs(coarse)); // and it converges (measured 1.38% → 0.54%)
 }
 
+// Issue 17 item 14: the drained-face reset of eq. 2.1 must follow a geometric rule that a settlement
+// of round-off size cannot switch off. Before, a point counted as a face point only while its GIMP
+// domain reached the face to 1e-9 h: a column that had sunk 1.3e-10 m lost its reset and the outer
+// layer took its interior value. The rule (theory.md eq. 2.1): a water point whose centre lies within
+// two of its half-lengths (one point spacing) of the face carries p̄, so the outer layer stays a face
+// layer until it has moved half a point spacing off the face, and the next layer never is one. The
+// column starts 1% of a point spacing below its drained top (both phases), as after a settlement.
+TEST(DrainedFace, TheOuterLayerHoldsTheFacePressureAfterTheColumnSettles)
+{
+	TerzaghiColumn c(0.05, 2.2e8, TimeScheme::Explicit);
+	const double   spacing = c.cellSize / c.perCell, settled = 0.01 * spacing;
+	for (auto& x : c.solid.position) x.z() -= settled;
+	for (auto& x : c.fluid.position) x.z() -= settled;
+	std::vector<bool> outer(c.fluid.size());
+	for (std::size_t p = 0; p < c.fluid.size(); ++p) outer[p] = c.fluid.position[p].z() > c.height - spacing;
+	double worstOuter = 0, leastNext = c.p0;
+	for (int step = 0; step < 200; ++step) {
+		c.solver->step(0.5 * c.solver->timeStepLimits().critical);
+		for (std::size_t p = 0; p < c.fluid.size(); ++p) {
+			if (outer[p]) worstOuter = std::max(worstOuter, std::abs(c.fluid.porePressure[p]));
+			else if (c.fluid.position[p].z() > c.height - 2 * spacing) leastNext = std::min(leastNext, c.fluid.porePressure[p]);
+		}
+	}
+	std::printf("outer layer: max |p| %.3g Pa; next layer: min p %.1f Pa (p0 %.0f)\n", worstOuter, leastNext, c.p0);
+	EXPECT_EQ(worstOuter, 0.0);        // p̄ = 0 exactly on the face layer at every step
+	EXPECT_GT(leastNext, 0.05 * c.p0); // the second layer is interior: its pressure is the solution's, not p̄
+}
+
 INSTANTIATE_TEST_SUITE_P(Schemes, TerzaghiConsolidation, ::testing::Values(TimeScheme::SemiImplicit, TimeScheme::Explicit),
                          [](const auto& param) { return std::string(fixtures::schemeName(param.param)); });
 

@@ -215,13 +215,18 @@ TEST(DrainedFaces, HydrostaticWaterTableOnTheSidesKeepsTheColumnAtRest)
 		for (std::size_t p = 0; p < c.fluid.size(); ++p) v = std::max({ v, c.fluid.velocity[p].norm(), c.solid.velocity[p].norm() });
 		if (getenv("MPM_PROFILE")) std::printf("  t+%.2f s: max speed %.2e\n", 0.05 * (i + 1), v);
 	}
-	double pErr = 0, vmax = 0;
+	// The top layer (centres within one point spacing h/2 of the drained top, eq. 2.1) is held at 0
+	// about h/4 below the surface; every other point must carry the hydrostatic pressure.
+	double pErr = 0, topErr = 0, vmax = 0;
 	for (std::size_t p = 0; p < c.fluid.size(); ++p) {
-		pErr = std::max(pErr, std::abs(c.fluid.porePressure[p] - gammaW * (H - c.fluid.position[p].z())) / (gammaW * H));
+		const double z = c.fluid.position[p].z(), err = std::abs(c.fluid.porePressure[p] - gammaW * (H - z)) / (gammaW * H);
+		if (z >= H - h / 2) topErr = std::max(topErr, std::abs(c.fluid.porePressure[p]) / (gammaW * H));
+		else pErr = std::max(pErr, err);
 		vmax = std::max({ vmax, c.fluid.velocity[p].norm(), c.solid.velocity[p].norm() });
 	}
-	std::printf("water table on the sides: max p error %.4f of γw H, max speed %.2e m/s\n", pErr, vmax);
-	EXPECT_LT(pErr, h / (4 * H) + 1e-9); // the top layer is held at 0, h/4 below the surface
+	std::printf("water table on the sides: max p error %.2e of γw H below the top layer, top layer |p| %.2e, max speed %.2e m/s\n", pErr, topErr, vmax);
+	EXPECT_EQ(topErr, 0.0);
+	EXPECT_LT(pErr, 1e-3);
 	// Without the face tractions the water leaves sideways at Darcy speed (k/n = 2.5e-4 m/s here);
 	// with tractions evaluated at the node (not at the centroid of N) the edge imbalance drove
 	// 7e-4 m/s. What remains (measured 8e-5 m/s, about 0.3 k/n) comes from the points treating p
