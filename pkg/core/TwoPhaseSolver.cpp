@@ -212,7 +212,7 @@ long TwoPhaseSolver::subStepsFor(Real dt, TimeStepLimits& limits) const
 	return needed < 1 ? 1 : needed > static_cast<Real>(std::numeric_limits<long>::max() / 2) ? std::numeric_limits<long>::max() / 2 : static_cast<long>(needed);
 }
 
-long TwoPhaseSolver::advance(Real dt)
+AdvanceReport TwoPhaseSolver::advance(Real dt, const std::atomic<bool>* stop)
 {
 	const long substeps = subStepsFor(dt, lastLimits_);
 	if (substeps > settings_.maxSubSteps) {
@@ -221,14 +221,20 @@ long TwoPhaseSolver::advance(Real dt)
 		    << lastLimits_.critical << " s, more than maxSubSteps = " << settings_.maxSubSteps;
 		throw TooManySubSteps(msg.str(), substeps, lastLimits_.critical);
 	}
+	AdvanceReport report;
+	report.planned = substeps;
 	for (long i = 0; i < substeps; ++i) {
+		if (stop && stop->load(std::memory_order_relaxed)) break;
 		try {
 			step(dt / substeps);
 		} catch (const InstabilityError& e) {
 			throw InstabilityError(std::string(e.what()) + " (sub-step " + std::to_string(i + 1) + " of " + std::to_string(substeps) + ")");
 		}
+		++report.subSteps;
 	}
-	return substeps;
+	// the whole dt exactly when nothing stopped it (no round-off from the product)
+	report.time = report.interrupted() ? report.subSteps * (dt / substeps) : dt;
+	return report;
 }
 
 void TwoPhaseSolver::step(Real dt)

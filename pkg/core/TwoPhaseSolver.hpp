@@ -7,6 +7,7 @@
 #include "Stages.hpp"
 
 #include <array>
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,13 @@ struct TimeStepLimits {
 	Real critical; // min of the above [s]
 };
 
+// What advance(dt) did: `subSteps` of the `planned` ones, `time` = subSteps × dt/planned [s].
+struct AdvanceReport {
+	long subSteps = 0, planned = 0;
+	Real time = 0;
+	bool interrupted() const { return subSteps < planned; }
+};
+
 enum class Stage {
 	ResetGrid,
 	MapSolidToGrid,
@@ -87,10 +95,11 @@ public:
 	// One explicit step of size dt (no sub-stepping). Throws InstabilityError naming the step,
 	// the point and the quantity if the state stops being finite or a point leaves the grid.
 	void step(Real dt);
-	// Advance by dt in equal sub-steps no larger than timeStepFactor × critical; returns their number.
-	// The limits it used are kept in lastTimeStepLimits(). More than maxSubSteps: TooManySubSteps,
-	// nothing advanced.
-	long                  advance(Real dt);
+	// Advance by dt in equal sub-steps no larger than timeStepFactor × critical. The limits it used
+	// are kept in lastTimeStepLimits(). More than maxSubSteps: TooManySubSteps, nothing advanced.
+	// `stop`, when given, is polled before every sub-step; once it is set, advance returns with the
+	// sub-steps done so far (an interrupt: the state is that of the last whole sub-step).
+	AdvanceReport         advance(Real dt, const std::atomic<bool>* stop = nullptr);
 	// The sub-steps advance(dt) would take now (the critical step of the current state, theory.md §5,
 	// eq. 8.10), with the limits they follow; advances nothing.
 	long                  subStepsFor(Real dt, TimeStepLimits& limits) const;

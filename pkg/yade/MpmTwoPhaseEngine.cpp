@@ -3,6 +3,7 @@
 #include "MpmHdf5Recorder.hpp"
 #include "MpmMaterials.hpp"
 #include "MpmPointShapes.hpp"
+#include "SigintWindow.hpp"
 #include "Serialization.hpp"
 
 #include <boost/serialization/vector.hpp>
@@ -163,8 +164,12 @@ void MpmTwoPhaseEngine::action()
 		}
 	}
 	solver_->setPoints(std::move(solids), std::move(waters), water, waterNames); // validates every point set
+	mpm::AdvanceReport advanced;
+	bool               interrupted = false;
 	try {
-		subStepsLast = solver_->advance(dt);
+		const SigintWindow interrupt; // Ctrl-C ends the step after the sub-step in progress
+		advanced    = solver_->advance(dt, &interrupt.flag());
+		interrupted = interrupt.requested(); // also after the last sub-step: the run stops all the same
 	} catch (const mpm::TooManySubSteps& e) {
 		std::ostringstream msg;
 		msg << "O.dt = " << dt << " s needs " << e.needed << " sub-steps of timeStepFactor × criticalTimeStep = " << timeStepFactor << " × "
@@ -176,6 +181,7 @@ void MpmTwoPhaseEngine::action()
 		msg << "O.iter = " << yade::abi::iter(scene) << " (O.time = " << yade::abi::time(scene) << " s): " << e.what();
 		throw mpm::InstabilityError(msg.str());
 	}
+	subStepsLast     = advanced.subSteps;
 	criticalTimeStep = solver_->lastTimeStepLimits().critical;
 	pressureSolveIterations = solver_->lastPressureSolve().iterations;
 	solverSteps      = solver_->stepCount();
@@ -185,8 +191,28 @@ void MpmTwoPhaseEngine::action()
 	waterPointCount  = fluid;
 	lastDt           = dt;
 	lastIter         = yade::abi::iter(scene);
-	mpmTime += dt;
+	mpmTime += advanced.time;
 	++stepsDone;
+	if (interrupted) stopAfterInterrupt(dt, advanced);
+}
+
+void MpmTwoPhaseEngine::stopAfterInterrupt(yade::Real dt, const mpm::AdvanceReport& advanced)
+{
+	// YADE adds O.dt to O.time after the engines; taking the part not advanced off now leaves
+	// O.time = mpmTime at the end of this step with O.dt as the user set it.
+	yade::abi::time(scene) -= dt - advanced.time;
+	std::ostringstream msg;
+	msg << "MpmTwoPhaseEngine: interrupted (SIGINT) at O.iter = " << yade::abi::iter(scene) << " after " << advanced.subSteps << " of " << advanced.planned
+	    << " sub-steps: this step advances O.time by " << advanced.time << " s of O.dt = " << dt << " s, so that O.time = mpmTime = " << mpmTime
+	    << " s; the run is paused\n";
+	const PyGILState_STATE gil = PyGILState_Ensure();
+	PySys_WriteStderr("%s", msg.str().c_str());
+	try {
+		boost::python::import("yade.wrapper").attr("Omega")().attr("pause")(); // as a PyRunner would; the KeyboardInterrupt follows in the main thread
+	} catch (const boost::python::error_already_set&) {
+		PyErr_Print();
+	}
+	PyGILState_Release(gil);
 }
 
 std::string MpmTwoPhaseEngine::checkOtherEngines() const

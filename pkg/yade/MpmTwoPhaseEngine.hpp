@@ -60,6 +60,8 @@ public:
 
 	MpmTwoPhaseEngine() = default;
 	~MpmTwoPhaseEngine() override;
+	// Advances every MPM body by O.dt in sub-steps; Ctrl-C ends it after the sub-step in progress,
+	// with O.time = mpmTime, and pauses the run (SigintWindow.hpp).
 	void action() override;
 	void callPostLoad() override;
 	void pyRegisterClass(boost::python::object scope) override;
@@ -72,6 +74,7 @@ public:
 	const mpm::TwoPhaseSolver* solver() const { return solver_.get(); }
 
 private:
+	void stopAfterInterrupt(yade::Real dt, const mpm::AdvanceReport& advanced);
 	// Everything the solver is built from except the values held on drained faces, which a
 	// running solver takes over in place (a rising head set every step must not rebuild it).
 	using Structure = std::tuple<std::string, yade::Real, yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, bool, yade::Real, bool,

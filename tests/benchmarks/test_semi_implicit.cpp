@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -210,6 +211,39 @@ TEST(Outflow, PointsCrossingADrainedFaceLeaveWithTheirMass)
 	for (const Vec3& x : fluid.position) EXPECT_GE(x.z(), 0); // none left below the face
 }
 
+// An interrupt (Ctrl-C in the binding) is a flag advance() polls before each sub-step: set, no
+// sub-step is taken and the state is untouched; clear, all planned sub-steps run and the time is the
+// whole dt to the bit (the binding adds it to mpmTime, which must equal O.time).
+TEST(Advance, AStopFlagEndsItBetweenSubStepsAndTheTimeIsWhatWasDone)
+{
+	const double    h = 0.02, a = 0.1, H = 0.2;
+	WaterParameters water;
+	const auto      l     = fixtures::lattice(Vec3::Zero(), Vec3(a, 3 * h, H), h, 2);
+	WaterPointSet   fluid = fixtures::waterLattice(l, 1.0, water.density);
+	Domain          d;
+	d.upper    = Vec3(0.6, 3 * h, 0.3);
+	d.cellSize = h;
+	for (int f = 0; f < faceCount; ++f) d.boundaries.walls[f] = { SolidWall::Free, WaterWall::Impermeable };
+	SolverSettings s;
+	s.gravity = Vec3(0, 0, -g0);
+	TwoPhaseSolver solver(d, s);
+	solver.setPoints({}, { &fluid }, water);
+	const auto        before = fluid.position;
+	std::atomic<bool> stop { true };
+	const AdvanceReport stopped = solver.advance(0.1, &stop);
+	EXPECT_GT(stopped.planned, 1);
+	EXPECT_EQ(stopped.subSteps, 0);
+	EXPECT_EQ(stopped.time, 0.0);
+	EXPECT_TRUE(stopped.interrupted());
+	EXPECT_TRUE(fluid.position == before);
+	stop = false;
+	const AdvanceReport whole = solver.advance(0.1, &stop);
+	EXPECT_EQ(whole.subSteps, whole.planned);
+	EXPECT_EQ(whole.time, 0.1);
+	EXPECT_FALSE(whole.interrupted());
+	EXPECT_EQ(solver.stepCount(), whole.planned);
+}
+
 // Free water released from rest (a dam break, real water): with no skeleton and no speed yet, only
 // gravity bounds the step (eq. 8.10): the fall limit √(h/|g|) and the speed |g| O.dt the points may
 // reach within one O.dt. One O.dt of 0.1 s is split by it and the column collapses without a point
@@ -233,7 +267,7 @@ TEST(SemiImplicitFreeWater, DamBreakFromRestTakesTheFallLimit)
 	solver.setPoints({}, { &fluid }, water);
 	EXPECT_NEAR(solver.timeStepLimits().critical, std::sqrt(h / g0), 1e-15);
 	const double mass = std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0);
-	const long   steps = solver.advance(0.1);
+	const long   steps = solver.advance(0.1).subSteps;
 	double       front = 0;
 	for (const Vec3& x : fluid.position) front = std::max(front, x.x());
 	std::printf("dam break: 0.1 s in %ld sub-steps, front at x/a = %.2f\n", steps, front / a);

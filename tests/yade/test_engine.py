@@ -1,4 +1,6 @@
 """MpmTwoPhaseEngine runs inside O.engines once per step and sees the scene's dt, time and iter."""
+import json
+
 import numpy as np
 import pytest
 
@@ -6,6 +8,7 @@ import yade.wrapper as w
 from yade import O
 
 import yade_mpm
+from conftest import run_script
 
 
 def test_runs_once_per_step_and_sees_dt_time_iter():
@@ -123,6 +126,64 @@ def test_an_o_dt_far_above_the_critical_step_is_refused_before_any_work():
     O.step()
     assert engine.stepsDone == 1 and 1 < engine.subStepsLast <= 40
     assert engine.subStepsLast == int(np.ceil(1e-3 / (engine.timeStepFactor * engine.criticalTimeStep)))
+
+
+def test_ctrl_c_stops_a_long_step_within_a_second_with_o_time_equal_to_mpm_time(tmp_path):
+    """Issue 17 item 1: YADE's O.run(n, True) ignores SIGINT until its n steps are done, so an O.dt of
+    2e5 sub-steps (about 20 s here) could not be stopped. A SIGINT during the MPM step ends it after
+    the sub-step in progress: the run pauses, KeyboardInterrupt reaches the script within a second,
+    O.time equals mpmTime (the step advanced only what was done; O.dt stays), the state is finite, and
+    the scene goes on. A SIGINT while no step runs is Python's alone and stops no later run."""
+    result = run_script("""
+        import json, os, signal, threading, time
+        import numpy as np
+        import yade_mpm
+        from yade import O, wrapper as w
+        soil, water = w.MpmSoilMat(), w.MpmWaterMat()
+        O.materials.append([soil, water])
+        g = (0, 0, -9.81)
+        solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (0.05, 0.05, 0.2), 0.05, soil, water, points_per_cell=2, gravity=g)
+        O.bodies.append([solid_body, water_body])
+        engine = w.MpmTwoPhaseEngine(gravity=g, domainMin=(0, 0, 0), domainMax=(0.05, 0.05, 0.2), cellSize=0.05, maxSubSteps=10**7,
+                                     solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("drained",))
+        O.engines = [engine]
+        O.dt = 1e-5
+        O.step()  # learns the critical step
+        sub_step = engine.timeStepFactor * engine.criticalTimeStep
+        O.dt = long_dt = 200000 * sub_step
+        start = O.time
+        sent = {}
+        def interrupt():
+            sent["at"] = time.monotonic()
+            os.kill(os.getpid(), signal.SIGINT)
+        threading.Timer(1.0, interrupt).start()
+        out = {"interrupted": False}
+        try:
+            O.run(5, True)
+        except KeyboardInterrupt:
+            out["interrupted"] = True
+        out.update(latency=time.monotonic() - sent["at"], iter=O.iter, time=O.time, mpmTime=engine.mpmTime, dt=O.dt, long_dt=long_dt,
+                   start=start, finite=bool(np.isfinite(solid_body.shape.pos).all() and np.isfinite(water_body.shape.porePressure).all()))
+        try:  # Ctrl-C between runs
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.5)
+        except KeyboardInterrupt:
+            out["idle_interrupt"] = True
+        O.dt = 0.5 * sub_step
+        O.run(3, True)
+        out.update(after_iter=O.iter, after_time=O.time, after_mpm_time=engine.mpmTime)
+        print("RESULT", json.dumps(out))
+    """, tmp_path)
+    assert result.returncode == 0, result.stderr
+    out = json.loads(result.stdout.split("RESULT", 1)[1])
+    assert out["interrupted"] and out["latency"] < 1.0, out
+    assert "interrupted (SIGINT) at O.iter = 1 after" in result.stderr and "the run is paused" in result.stderr
+    assert out["iter"] == 2 and out["dt"] == out["long_dt"]  # the interrupted step counts; O.dt is the user's
+    assert out["start"] < out["time"] < out["start"] + 0.5 * out["long_dt"]  # stopped well before the step's end
+    assert abs(out["time"] - out["mpmTime"]) <= 1e-12 * out["time"]  # to round-off
+    assert out["finite"] and out.get("idle_interrupt")
+    assert out["after_iter"] == out["iter"] + 3  # the idle Ctrl-C stopped nothing
+    assert abs(out["after_time"] - out["after_mpm_time"]) <= 1e-12 * out["after_time"]
 
 
 def test_two_engines_or_a_shared_point_set_are_refused_before_any_work():
