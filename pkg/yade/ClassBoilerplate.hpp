@@ -1,4 +1,4 @@
-// The virtual overrides every plugin class needs, written once. `Cls` is the class, `Base` its YADE
+// The virtual overrides every plugin class needs, and its serialization, written once. `Cls` is the class, `Base` its YADE
 // base. Index functions are added for Indexable kins (Shape, Material) with MPM_INDEXABLE.
 #pragma once
 
@@ -12,7 +12,13 @@ public:                                                                         
 		yade_mpm::setAttrFromTable<Cls, yade::Base>(*this, key, value);                                         \
 	}                                                                                                               \
 	boost::python::dict pyDict() const override { return yade_mpm::dictFromTable<Cls, yade::Base>(*this); }        \
-	static const yade_mpm::AttrTable<Cls>& attributes();
+	static const yade_mpm::AttrTable<Cls>& attributes();                                                            \
+	/* saved scenes: the base, then every attribute the table marks as saved, in table order */                    \
+	template <class Archive> void serialize(Archive& ar, unsigned int)                                              \
+	{                                                                                                               \
+		ar& boost::serialization::make_nvp(#Base, boost::serialization::base_object<yade::Base>(*this));          \
+		yade_mpm::serializeAttributes(ar, *this);                                                               \
+	}
 
 // A class-unique index among its kin (YADE dispatchers look functors up by it).
 #define MPM_INDEXABLE(Cls, Base)                                                                                    \

@@ -193,16 +193,6 @@ void MpmHdf5Recorder::pyRegisterClass(py::object scope)
 	        scope, "Writes the MPM point sets (positions, velocities, stresses, pore pressures, porosities, volumes) and the background grid to HDF5 every iterPeriod iterations, with an XDMF index that ParaView opens. Read back with yade_mpm.results.read(file). A record holding a non-finite value is refused with an error; earlier records stay intact.");
 }
 
-template <class Archive> void MpmHdf5Recorder::serialize(Archive& ar, unsigned int)
-{
-	ar& boost::serialization::make_nvp("GlobalEngine", boost::serialization::base_object<yade::GlobalEngine>(*this));
-	ar& BOOST_SERIALIZATION_NVP(file);
-	ar& BOOST_SERIALIZATION_NVP(iterPeriod);
-	ar& BOOST_SERIALIZATION_NVP(recordGrid);
-	ar& BOOST_SERIALIZATION_NVP(records);
-	ar& BOOST_SERIALIZATION_NVP(lastRecord);
-}
-
 } // namespace yade_mpm
 
 BOOST_CLASS_EXPORT_KEY2(yade_mpm::MpmHdf5Recorder, "MpmHdf5Recorder")

@@ -32,7 +32,6 @@ public:
 	void checkFile(const std::vector<boost::shared_ptr<yade::Engine>>* engines) const;
 	bool started() const { return writer_ != nullptr; }
 	void pyRegisterClass(boost::python::object scope) override;
-	template <class Archive> void serialize(Archive& ar, unsigned int version);
 	MPM_SERIALIZABLE_OVERRIDES(MpmHdf5Recorder, GlobalEngine)
 
 private:

@@ -11,21 +11,11 @@
 
 namespace yade_mpm {
 
+// Storage is the core's own parameter structs; the attribute table (MpmMaterials.cpp) declares each
+// attribute once. Material::density is the constituent's intrinsic density and is copied into the
+// core struct when the parameters are read.
 class MpmSoilMat : public yade::Material {
 public:
-	yade::Real youngModulus          = mpm::SoilParameters {}.youngModulus;          // E [Pa]
-	yade::Real poissonRatio          = mpm::SoilParameters {}.poissonRatio;          // ν [-]
-	yade::Real porosity              = mpm::SoilParameters {}.porosity;              // n0 [-]
-	yade::Real intrinsicPermeability = mpm::SoilParameters {}.intrinsicPermeability; // κ [m²]
-	bool       kozenyCarman          = false; // κ(n) by the Kozeny–Carman ratio
-	std::string model                 = "linearElastic"; // linearElastic | DruckerPrager | MohrCoulomb
-	yade::Real frictionAngle          = mpm::StrengthParameters {}.frictionAngle;         // φ [rad]
-	yade::Real dilatancyAngle         = mpm::StrengthParameters {}.dilatancyAngle;        // ψ [rad]
-	yade::Real cohesion               = mpm::StrengthParameters {}.cohesion;              // c [Pa]
-	yade::Real tensionCutoff          = mpm::StrengthParameters {}.tensionCutoff;         // σ_t [Pa]
-	yade::Real residualFrictionAngle  = mpm::StrengthParameters {}.residualFrictionAngle; // φ_r [rad]
-	yade::Real softeningStrain        = mpm::StrengthParameters {}.softeningStrain;       // κ_s [-]
-
 	MpmSoilMat()
 	{
 		density = mpm::SoilParameters {}.density;
@@ -33,20 +23,23 @@ public:
 	}
 	~MpmSoilMat() override;
 	mpm::SoilParameters     parameters() const; // validated core parameters
-	mpm::SkeletonModel      skeletonModel() const;
+	mpm::SkeletonModel      skeletonModel() const { return model_; }
 	mpm::StrengthParameters strength() const; // validated when the model is plastic
-	void                callPostLoad() override;
-	void                pyRegisterClass(boost::python::object scope) override;
-	template <class Archive> void serialize(Archive& ar, unsigned int version);
+	bool                    kozenyCarman() const { return kozenyCarman_; }
+	void                    callPostLoad() override;
+	void                    pyRegisterClass(boost::python::object scope) override;
 	MPM_SERIALIZABLE_OVERRIDES(MpmSoilMat, Material)
 	MPM_INDEXABLE(MpmSoilMat, Material)
+
+private:
+	mpm::SoilParameters     soil_;     // all but density (Material::density)
+	mpm::SkeletonModel      model_ = mpm::SkeletonModel::LinearElastic;
+	mpm::StrengthParameters strength_;
+	bool                    kozenyCarman_ = false; // κ(n) by the Kozeny–Carman ratio
 };
 
 class MpmWaterMat : public yade::Material {
 public:
-	yade::Real bulkModulus = mpm::WaterParameters {}.bulkModulus; // Kw [Pa]
-	yade::Real viscosity   = mpm::WaterParameters {}.viscosity;   // μw [Pa s]
-
 	MpmWaterMat()
 	{
 		density = mpm::WaterParameters {}.density;
@@ -56,9 +49,11 @@ public:
 	mpm::WaterParameters parameters() const; // validated core parameters
 	void                 callPostLoad() override;
 	void                 pyRegisterClass(boost::python::object scope) override;
-	template <class Archive> void serialize(Archive& ar, unsigned int version);
 	MPM_SERIALIZABLE_OVERRIDES(MpmWaterMat, Material)
 	MPM_INDEXABLE(MpmWaterMat, Material)
+
+private:
+	mpm::WaterParameters water_; // all but density (Material::density)
 };
 
 } // namespace yade_mpm

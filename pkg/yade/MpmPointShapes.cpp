@@ -17,23 +17,18 @@ namespace {
 	{
 		static const std::string posDoc  = std::string("Positions of the ") + phase + " points, shape (N, 3) [m]. Assigning it sets the number of points N.";
 		static const std::string velDoc  = std::string("Velocities of the ") + phase + " points, shape (N, 3) [m s⁻¹]";
+		static const std::string massDoc = std::string(phase) == "solid" ? "Solid mass of each point m_sp = (1−n0) ρs V0, shape (N,) [kg]"
+		                                                                 : "Water mass of each point m_wp = n0 ρw V0, shape (N,) [kg]";
 		return {
 			pointArrayAttr(pointFieldNames.position, points, &mpm::MaterialPointSet::position, posDoc.c_str(), true),
 			pointArrayAttr(pointFieldNames.velocity, points, &mpm::MaterialPointSet::velocity, velDoc.c_str()),
+			pointArrayAttr("mass", points, &mpm::MaterialPointSet::mass, massDoc.c_str()),
 			pointArrayAttr("volume", points, &mpm::MaterialPointSet::volume, "Current mixture volume represented by each point, shape (N,) [m³]"),
 			pointArrayAttr("halfLength", points, &mpm::MaterialPointSet::halfLength, "GIMP half-lengths of each point's domain l_p, shape (N, 3) [m]"),
 			readOnly(AttrSpec<Owner> { "count", "Number of points N [-]", [points](const Owner& o) { return py::object((o.*points).size()); }, nullptr }),
 		};
 	}
 
-	template <class Archive> void serializeCommon(Archive& ar, mpm::MaterialPointSet& points)
-	{
-		serializeFlat(ar, "position", points.position);
-		serializeFlat(ar, "velocity", points.velocity);
-		serializeFlat(ar, "mass", points.mass);
-		serializeFlat(ar, "volume", points.volume);
-		serializeFlat(ar, "halfLength", points.halfLength);
-	}
 } // namespace
 
 const AttrTable<MpmSolidPoints>& MpmSolidPoints::attributes()
@@ -42,16 +37,15 @@ const AttrTable<MpmSolidPoints>& MpmSolidPoints::attributes()
 	static const AttrTable<S> table = [] {
 		AttrTable<S> t = commonPointAttributes(&S::points, "solid");
 		for (auto&& spec : AttrTable<S> {
-		             pointArrayAttr("mass", &S::points, &SolidPointSet::mass, "Solid mass of each point m_sp = (1−n0) ρs V0, shape (N,) [kg]"),
 		             pointArrayAttr("initialVolume", &S::points, &SolidPointSet::initialVolume, "Initial mixture volume of each point V0, shape (N,) [m³]"),
 		             pointArrayAttr("initialHalfLength", &S::points, &SolidPointSet::initialHalfLength, "Initial GIMP half-lengths l0_p, shape (N, 3) [m]"),
 		             pointArrayAttr(pointFieldNames.deformationGradient, &S::points, &SolidPointSet::deformationGradient, "Deformation gradient F of each point, shape (N, 3, 3) [-]"),
 		             pointArrayAttr(pointFieldNames.effectiveStress, &S::points, &SolidPointSet::effectiveStress, "Effective stress σ′ (tension-positive), symmetric, shape (N, 3, 3) [Pa]"),
 		             pointArrayAttr("porosity", &S::points, &SolidPointSet::porosity, "Porosity n of the mixture at each solid point, shape (N,) [-]"),
-		             pointArrayAttr("plasticShearStrain", &S::points, &SolidPointSet::plasticShearStrain,
-		                            "Accumulated plastic shear strain κ of each point, shape (N,) [-]"),
 		             pointArrayAttr(pointFieldNames.externalForce, &S::points, &SolidPointSet::externalForce,
 		                            "Prescribed load on each point, e.g. a surface traction times the point's face area, shape (N, 3) [N]"),
+		             pointArrayAttr("plasticShearStrain", &S::points, &SolidPointSet::plasticShearStrain,
+		                            "Accumulated plastic shear strain κ of each point, shape (N,) [-]"),
 		     })
 			t.push_back(std::move(spec));
 		return t;
@@ -65,7 +59,6 @@ const AttrTable<MpmWaterPoints>& MpmWaterPoints::attributes()
 	static const AttrTable<W> table = [] {
 		AttrTable<W> t = commonPointAttributes(&W::points, "water");
 		for (auto&& spec : AttrTable<W> {
-		             pointArrayAttr("mass", &W::points, &WaterPointSet::mass, "Water mass of each point m_wp = n0 ρw V0, shape (N,) [kg]"),
 		             pointArrayAttr("porePressure", &W::points, &WaterPointSet::porePressure, "Pore-water pressure p (compression-positive), shape (N,) [Pa]"),
 		             pointArrayAttr("porosity", &W::points, &WaterPointSet::porosity, "Porosity n interpolated at each water point (1 for free water), shape (N,) [-]"),
 		     })
@@ -85,27 +78,6 @@ void MpmWaterPoints::pyRegisterClass(py::object scope)
 {
 	registerPythonClass<MpmWaterPoints, yade::Shape>(
 	        scope, "The pore-water material points of one body: positions, velocities, masses, volumes, GIMP domains, pore pressures and porosities, stored as one array per field.");
-}
-
-template <class Archive> void MpmSolidPoints::serialize(Archive& ar, unsigned int)
-{
-	ar& boost::serialization::make_nvp("Shape", boost::serialization::base_object<yade::Shape>(*this));
-	serializeCommon(ar, points);
-	serializeFlat(ar, "initialVolume", points.initialVolume);
-	serializeFlat(ar, "initialHalfLength", points.initialHalfLength);
-	serializeFlat(ar, "deformationGradient", points.deformationGradient);
-	serializeFlat(ar, "effectiveStress", points.effectiveStress);
-	serializeFlat(ar, "porosity", points.porosity);
-	serializeFlat(ar, "externalForce", points.externalForce);
-	serializeFlat(ar, "plasticShearStrain", points.plasticShearStrain);
-}
-
-template <class Archive> void MpmWaterPoints::serialize(Archive& ar, unsigned int)
-{
-	ar& boost::serialization::make_nvp("Shape", boost::serialization::base_object<yade::Shape>(*this));
-	serializeCommon(ar, points);
-	serializeFlat(ar, "porePressure", points.porePressure);
-	serializeFlat(ar, "porosity", points.porosity);
 }
 
 } // namespace yade_mpm

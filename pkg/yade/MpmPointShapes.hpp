@@ -22,7 +22,6 @@ public:
 	MpmSolidPoints() { createIndex(); }
 	~MpmSolidPoints() override;
 	void pyRegisterClass(boost::python::object scope) override;
-	template <class Archive> void serialize(Archive& ar, unsigned int version);
 	MPM_SERIALIZABLE_OVERRIDES(MpmSolidPoints, Shape)
 	MPM_INDEXABLE(MpmSolidPoints, Shape)
 };
@@ -34,7 +33,6 @@ public:
 	MpmWaterPoints() { createIndex(); }
 	~MpmWaterPoints() override;
 	void pyRegisterClass(boost::python::object scope) override;
-	template <class Archive> void serialize(Archive& ar, unsigned int version);
 	MPM_SERIALIZABLE_OVERRIDES(MpmWaterPoints, Shape)
 	MPM_INDEXABLE(MpmWaterPoints, Shape)
 };

@@ -19,31 +19,20 @@ namespace yade_mpm {
 
 namespace {
 
-	// Map a user's option name to the core enum; unknown names are refused listing the valid ones.
-	template <class Enum, std::size_t N>
-	Enum parseOption(const std::string& attribute, const std::string& value, const std::array<std::pair<const char*, Enum>, N>& options)
-	{
-		std::string valid;
-		for (const auto& [name, e] : options) {
-			if (value == name) return e;
-			valid += (valid.empty() ? "" : ", ") + std::string(name);
-		}
-		throw mpm::InvalidParameter(attribute + " = '" + value + "' is not one of: " + valid);
-	}
-
-	const std::array<std::pair<const char*, mpm::ShapeFunction>, 3> shapeOptions {
-		{ { "linear", mpm::ShapeFunction::Linear }, { "uGIMP", mpm::ShapeFunction::UGimp }, { "cpGIMP", mpm::ShapeFunction::CpGimp } }
-	};
-	const std::array<std::pair<const char*, mpm::TimeScheme>, 2> schemeOptions { { { "semi-implicit", mpm::TimeScheme::SemiImplicit },
-		                                                                         { "explicit", mpm::TimeScheme::Explicit } } };
-	const std::array<std::pair<const char*, mpm::DragScheme>, 2> dragOptions { { { "semi-implicit", mpm::DragScheme::SemiImplicit },
-		                                                                       { "explicit", mpm::DragScheme::Explicit } } };
-	const std::array<std::pair<const char*, mpm::SolidWall>, 4> solidWallOptions {
-		{ { "free", mpm::SolidWall::Free }, { "slip", mpm::SolidWall::Slip }, { "fixed", mpm::SolidWall::Fixed }, { "frictional", mpm::SolidWall::Frictional } }
-	};
-	const std::array<std::pair<const char*, mpm::WaterWall>, 3> waterWallOptions {
-		{ { "free", mpm::WaterWall::Free }, { "impermeable", mpm::WaterWall::Impermeable }, { "drained", mpm::WaterWall::Drained } }
-	};
+	const Options<mpm::ShapeFunction, 3> shapeOptions { { { "linear", mpm::ShapeFunction::Linear },
+		                                                { "uGIMP", mpm::ShapeFunction::UGimp },
+		                                                { "cpGIMP", mpm::ShapeFunction::CpGimp } } };
+	const Options<mpm::TimeScheme, 2>    schemeOptions { { { "semi-implicit", mpm::TimeScheme::SemiImplicit }, { "explicit", mpm::TimeScheme::Explicit } } };
+	const Options<mpm::DragScheme, 2>    dragOptions { { { "semi-implicit", mpm::DragScheme::SemiImplicit }, { "explicit", mpm::DragScheme::Explicit } } };
+	const Options<mpm::SolidWall, 4>     solidWallOptions { { { "free", mpm::SolidWall::Free },
+		                                                      { "slip", mpm::SolidWall::Slip },
+		                                                      { "fixed", mpm::SolidWall::Fixed },
+		                                                      { "frictional", mpm::SolidWall::Frictional } } };
+	const Options<mpm::WaterWall, 3>     waterWallOptions { { { "free", mpm::WaterWall::Free },
+		                                                      { "impermeable", mpm::WaterWall::Impermeable },
+		                                                      { "drained", mpm::WaterWall::Drained } } };
+	constexpr const char* faces = "xMin, xMax, yMin, yMax, zMin, zMax";
+	std::string           faceItem(int f) { return mpm::faceName(f); }
 
 	bool sameWater(const mpm::WaterParameters& a, const mpm::WaterParameters& b)
 	{
@@ -55,73 +44,41 @@ MpmTwoPhaseEngine::~MpmTwoPhaseEngine() = default;
 
 mpm::Domain MpmTwoPhaseEngine::domain() const
 {
-	mpm::Domain d;
-	d.lower    = domainMin;
-	d.upper    = domainMax;
-	d.cellSize = cellSize;
 	for (int f = 0; f < 6; ++f) {
-		auto& wall           = d.boundaries.walls[f];
-		wall.solid           = parseOption("solidWalls[" + std::string(mpm::faceName(f)) + "]", solidWalls[f], solidWallOptions);
-		wall.water           = parseOption("waterWalls[" + std::string(mpm::faceName(f)) + "]", waterWalls[f], waterWallOptions);
-		wall.drainedPressure = drainedPressure[f];
-		wall.traction        = faceTraction[f];
+		const mpm::WallConditions& wall = domain_.boundaries.walls[f];
+		const std::string          face = mpm::faceName(f);
 		if (!wall.traction.allFinite()) {
 			std::ostringstream value;
 			value << "(" << wall.traction[0] << ", " << wall.traction[1] << ", " << wall.traction[2] << ")";
-			mpm::throwOutOfRange("faceTraction[" + std::string(mpm::faceName(f)) + "]", value.str(), "Pa", "of finite vectors");
+			mpm::throwOutOfRange("faceTraction[" + face + "]", value.str(), "Pa", "of finite vectors");
 		}
-		wall.friction        = wallFriction[f];
-		if (!(wall.friction >= 0 && std::isfinite(wall.friction))) mpm::throwOutOfRange("wallFriction[" + std::string(mpm::faceName(f)) + "]", wall.friction, "", "[0, inf)");
-		wall.waterTable      = drainedWaterTable[f];
-		wall.inflow          = waterInflow[f] != 0;
+		if (!(wall.friction >= 0 && std::isfinite(wall.friction))) mpm::throwOutOfRange("wallFriction[" + face + "]", wall.friction, "", "[0, inf)");
 		if (wall.inflow && wall.water != mpm::WaterWall::Drained)
-			throw mpm::InvalidParameter("waterInflow[" + std::string(mpm::faceName(f)) + "] is set but waterWalls[" + mpm::faceName(f) + "] = '" + waterWalls[f] +
+			throw mpm::InvalidParameter("waterInflow[" + face + "] is set but waterWalls[" + face + "] = '" + optionName(wall.water, waterWallOptions) +
 			                            "': inflow needs a 'drained' face");
 		if (!(wall.waterTable < std::numeric_limits<yade::Real>::infinity()))
-			mpm::throwOutOfRange("drainedWaterTable[" + std::string(mpm::faceName(f)) + "]", wall.waterTable, "m", "[-inf (none), inf)");
-		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + std::string(mpm::faceName(f)) + "]", wall.drainedPressure, "Pa", "finite values");
+			mpm::throwOutOfRange("drainedWaterTable[" + face + "]", wall.waterTable, "m", "[-inf (none), inf)");
+		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + face + "]", wall.drainedPressure, "Pa", "finite values");
 	}
-	for (int axis = 0; axis < 3; ++axis) d.boundaries.periodic[axis] = periodic[axis] != 0;
-	d.boundaries.requireFreePeriodicFaces();
-	d.removeWaterLeavingGrid = removeWaterLeavingGrid;
-	d.removeFreeWater        = removeFreeWater;
-	if (waterSinks.size() % 2) throw mpm::InvalidParameter("waterSinks must hold (lower, upper) corner pairs; it has " + std::to_string(waterSinks.size()) + " corners");
-	for (std::size_t i = 0; i + 1 < waterSinks.size(); i += 2) {
-		if (!(waterSinks[i].array() <= waterSinks[i + 1].array()).all() || !waterSinks[i].allFinite() || !waterSinks[i + 1].allFinite())
-			mpm::throwOutOfRange("waterSinks[" + std::to_string(i / 2) + "] upper − lower", (waterSinks[i + 1] - waterSinks[i]).transpose(), "m", "finite, non-negative components");
-		d.sinks.push_back(mpm::WaterSink { waterSinks[i], waterSinks[i + 1] });
+	domain_.boundaries.requireFreePeriodicFaces();
+	for (std::size_t i = 0; i < domain_.sinks.size(); ++i) {
+		const mpm::WaterSink& sink = domain_.sinks[i];
+		if (!(sink.lower.array() <= sink.upper.array()).all() || !sink.lower.allFinite() || !sink.upper.allFinite())
+			mpm::throwOutOfRange("waterSinks[" + std::to_string(i) + "] upper − lower", (sink.upper - sink.lower).transpose(), "m", "finite, non-negative components");
 	}
 	for (int a = 0; a < 3; ++a)
-		if (!(domainMax[a] > domainMin[a])) mpm::throwOutOfRange("domainMax - domainMin", (domainMax - domainMin).transpose(), "m", "positive components");
-	return d;
-}
-
-mpm::SolverSettings MpmTwoPhaseEngine::settings() const
-{
-	mpm::SolverSettings s;
-	s.scheme                     = parseOption("scheme", scheme, schemeOptions);
-	s.pressureTolerance          = pressureTolerance;
-	s.shapeFunction              = parseOption("shapeFunction", shapeFunction, shapeOptions);
-	s.drag                       = parseOption("drag", drag, dragOptions);
-	s.flipBlend                  = flipBlend;
-	s.timeStepFactor             = timeStepFactor;
-	s.gravity                    = gravity;
-	s.cellAveragedVolumetricRate = cellAveraging;
-	s.pressureModeDamping        = pressureModeDamping;
-	s.freeSurfaceThreshold       = freeSurfaceThreshold;
-	s.freeSurfaceHoldsSuction    = freeSurfaceHoldsSuction;
-	s.maxSubSteps                = maxSubSteps;
-	s.validate();
-	return s;
+		if (!(domain_.upper[a] > domain_.lower[a])) mpm::throwOutOfRange("domainMax - domainMin", (domain_.upper - domain_.lower).transpose(), "m", "positive components");
+	return domain_;
 }
 
 void MpmTwoPhaseEngine::action()
 {
 	const yade::Real dt = yade::abi::dt(scene);
 	if (!solver_) {
-		solver_   = std::make_unique<mpm::TwoPhaseSolver>(domain(), settings());
+		solver_ = std::make_unique<mpm::TwoPhaseSolver>(domain(), settings_);
 		solver_->setFieldNames(pointFieldNames);
-		builtFor_ = structure();
+		removedBefore_  = removedWaterMass; // the totals so far (earlier solvers, or the saved scene)
+		injectedBefore_ = injectedWaterMass;
 	}
 
 	const std::string integrator = checkOtherEngines();
@@ -149,7 +106,7 @@ void MpmTwoPhaseEngine::action()
 		if (auto* s = dynamic_cast<MpmSolidPoints*>(shape.get())) {
 			auto* mat = dynamic_cast<MpmSoilMat*>(yade::abi::materialOf(body.get()).get());
 			if (!mat) throw mpm::InvalidParameter(where + " carries MpmSolidPoints but its material is not an MpmSoilMat");
-			solids.push_back(mpm::SolidSet { &s->points, mat->parameters(), mat->kozenyCarman, mat->skeletonModel(), mat->strength(), where + ".shape" });
+			solids.push_back(mpm::SolidSet { &s->points, mat->parameters(), mat->kozenyCarman(), mat->skeletonModel(), mat->strength(), where + ".shape" });
 			solid += static_cast<long>(s->points.size());
 		} else if (auto* w = dynamic_cast<MpmWaterPoints*>(shape.get())) {
 			auto* mat = dynamic_cast<MpmWaterMat*>(yade::abi::materialOf(body.get()).get());
@@ -172,8 +129,8 @@ void MpmTwoPhaseEngine::action()
 		interrupted = interrupt.requested(); // also after the last sub-step: the run stops all the same
 	} catch (const mpm::TooManySubSteps& e) {
 		std::ostringstream msg;
-		msg << "O.dt = " << dt << " s needs " << e.needed << " sub-steps of timeStepFactor × criticalTimeStep = " << timeStepFactor << " × "
-		    << e.criticalStep << " s, more than maxSubSteps = " << maxSubSteps << ": lower O.dt (at most " << maxSubSteps * timeStepFactor * e.criticalStep
+		msg << "O.dt = " << dt << " s needs " << e.needed << " sub-steps of timeStepFactor × criticalTimeStep = " << settings_.timeStepFactor << " × "
+		    << e.criticalStep << " s, more than maxSubSteps = " << settings_.maxSubSteps << ": lower O.dt (at most " << settings_.maxSubSteps * settings_.timeStepFactor * e.criticalStep
 		    << " s) or raise maxSubSteps (nothing was advanced)";
 		throw mpm::InvalidParameter(msg.str());
 	} catch (const mpm::InstabilityError& e) {
@@ -238,113 +195,98 @@ std::string MpmTwoPhaseEngine::checkOtherEngines() const
 	return integrator;
 }
 
-MpmTwoPhaseEngine::Structure MpmTwoPhaseEngine::structure() const
-{
-	return Structure { scheme, pressureTolerance, gravity,       timeStepFactor, flipBlend,  domainMin,  domainMax,  cellSize,               shapeFunction, drag,
-		           cellAveraging, pressureModeDamping, freeSurfaceThreshold, freeSurfaceHoldsSuction, solidWalls, wallFriction, waterWalls, waterSinks, removeWaterLeavingGrid, removeFreeWater, waterInflow, periodic, maxSubSteps };
-}
-
 void MpmTwoPhaseEngine::callPostLoad()
 {
 	yade::GlobalEngine::callPostLoad();
 	try {
-		settings();
+		settings_.validate();
 		const mpm::Domain d = domain();
-		if (solver_ && structure() == builtFor_) { // only drained values changed: keep the solver
+		if (solver_ && !solverStale_) { // only values held on the faces changed: keep the solver
 			solver_->updateDrainedValues(d.boundaries);
 			return;
 		}
 	} catch (const mpm::InvalidParameter& e) {
 		raisePython(PyExc_ValueError, "MpmTwoPhaseEngine: " + std::string(e.what()));
 	}
-	if (solver_) { // keep the totals across rebuilds
-		removedBefore_ += solver_->removedWaterMass();
-		injectedBefore_ += solver_->injectedWaterMass();
-	}
-	solver_.reset(); // any other change of the set-up rebuilds the grid and the constraints
+	solver_.reset(); // any other change rebuilds the grid and the constraints at the next step
+	solverStale_ = false;
 }
 
 const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 {
 	using E = MpmTwoPhaseEngine;
-	static const AttrTable<E> table {
-		vector3Attr("gravity", &E::gravity, "Gravitational acceleration acting on both phases b [m s⁻²]"),
-		realAttr("timeStepFactor", &E::timeStepFactor, "Safety factor C on the critical time step [-], 0 < C ≤ 1; O.dt is split into sub-steps no larger than C × criticalTimeStep"),
-		intAttr("maxSubSteps", &E::maxSubSteps,
-		        "Most sub-steps one O.dt may be split into [-], ≥ 1: an O.dt that would need more (a mistyped step, e.g. 10 s for a 1e-4 s critical step) is refused before any work, naming O.dt, criticalTimeStep and the sub-steps needed"),
-		realAttr("flipBlend", &E::flipBlend, "FLIP/PIC blend α of the grid-to-point velocity update [-], 0 ≤ α ≤ 1 (1 = pure FLIP, 0 = PIC)"),
-		vector3Attr("domainMin", &E::domainMin, "Lower corner of the domain box, whose faces are the walls [m]"),
-		vector3Attr("domainMax", &E::domainMax, "Upper corner of the domain box; each extent a whole number of cells [m]"),
-		realAttr("cellSize", &E::cellSize, "Cell size h of the background grid (cubic cells) [m]"),
-		stringAttr("shapeFunction", &E::shapeFunction, "Shape functions [-]: 'linear', 'uGIMP' (constant point domains) or 'cpGIMP' (domains follow the stretch)"),
-		stringAttr("scheme", &E::scheme,
-		           "Time integration of the pore pressure [-], default 'semi-implicit': the nodal pore pressure is solved implicitly each step (a projection, theory.md §8), so the step is limited by the skeleton's wave and the points' speed only, not by the water's bulk modulus or the permeability; real water (bulkModulus 2.2e9) and incompressible water (inf) cost no more. 'explicit': the pressure follows the water's volume rate point by point (theory.md §4), the step follows the undrained wave (≈20× smaller for sand with real water); it needs pressureModeDamping for long runs"),
-		realAttr("pressureTolerance", &E::pressureTolerance,
-		         "Accuracy of the semi-implicit pressure solve δp [Pa], > 0, default 1e-3: the conjugate gradient stops at the residual of a pressure error δp at a typical node"),
-		stringAttr("drag", &E::drag, "Drag integration of the explicit scheme [-]: 'semi-implicit' (no drag time-step limit) or 'explicit'; the semi-implicit scheme always takes the drag implicitly"),
-		boolAttr("cellAveraging", &E::cellAveraging, "Cell-averaged volumetric rates for the pore pressure and the skeleton (suppresses the pressure checkerboard) [-]"),
-		boolAttr("pressureModeDamping", &E::pressureModeDamping,
-		         "Explicit scheme only (default False; refused with scheme='semi-implicit', which needs no relaxation): pore-pressure modes the grid cannot see (cell and node checkerboards, which exert no nodal force and so are never drained) relax towards the nodal average at the rate c_v/h² at which seepage drains a one-cell perturbation (theory.md eq. 4.17b), and in wall, face and surface cells towards a local linear fit at a slower rate (eq. 4.17c); off, they can grow without bound in long runs [-]"),
-		realAttr("freeSurfaceThreshold", &E::freeSurfaceThreshold,
-		         "Free-surface detection β [-], 0 ≤ β < 1: water points whose filling Σ S V_water/V_full of their nodes is below β get p = 0 (0.75 keeps exactly the outer layer with 2 points per cell and axis); 0: off"),
-		boolAttr("freeSurfaceHoldsSuction", &E::freeSurfaceHoldsSuction,
-		         "Explicit scheme only (refused with scheme='semi-implicit'). With a free surface (freeSurfaceThreshold > 0): the surface keeps suction (p < 0), as capillary menisci hold the water to the grains there (no relative flow at its nodes), and releases only positive pressure, p = min(p, 0): a seepage face that lets water out but draws none in. False: p = 0 on every free-surface point, as under ponded water [-]"),
-		fixedListAttr("solidWalls", &E::solidWalls, 6,
-		              "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0), 'fixed' or 'frictional' (a contact: pushes the grains, never pulls them, and resists sliding by Coulomb friction wallFriction × the effective normal force; a fixed wall wins on a shared edge)"),
-		fixedListAttr("wallFriction", &E::wallFriction, 6, "Coulomb friction coefficient μ = tan δ per 'frictional' face [-], ≥ 0"),
-		fixedListAttr("waterWalls", &E::waterWalls, 6, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
-		fixedListAttr("drainedPressure", &E::drainedPressure, 6, "Uniform part of the pore pressure p̄ held on each 'drained' face [Pa]"),
-		AttrSpec<E> { "faceTraction",
-		              "Traction t per face (xMin, xMax, yMin, yMax, zMin, zMax) on the mixture, e.g. (0, 0, -q) on zMax for a surface load q on a soil whose top lies on that face, integrated as a boundary traction ∮ N t dA over the face (theory.md eq. 2.8); components a solid wall holds go to the wall; changed values apply in place [Pa]",
-		              [](const E& e) {
-			              py::list l;
-			              for (const auto& t : e.faceTraction) l.append(py::make_tuple(t[0], t[1], t[2])); // plain tuples, as the other per-face lists
-			              return py::object(py::tuple(l));
-		              },
-		              [](E& e, const py::object& v) {
-			              if (py::len(v) != 6) raisePython(PyExc_ValueError, "faceTraction needs 6 vectors (xMin, xMax, yMin, yMax, zMin, zMax) [Pa]");
-			              std::vector<yade::Vector3r> t;
-			              for (long i = 0; i < 6; ++i) t.push_back(toVector3("faceTraction", v[i]));
-			              e.faceTraction = t;
-		              } },
+	// One line per attribute, in the order a saved scene holds them. Inputs rebuild the solver when
+	// set, unless marked inPlace (the values held on the faces, e.g. a rising head set every step).
+	static const AttrTable<E> table = [] {
+		AttrTable<E> t {
+		valueAttr<E>("gravity", [](E& e) -> auto& { return e.settings_.gravity; }, "Gravitational acceleration acting on both phases b [m s⁻²]"),
+		valueAttr<E>("timeStepFactor", [](E& e) -> auto& { return e.settings_.timeStepFactor; }, "Safety factor C on the critical time step [-], 0 < C ≤ 1; O.dt is split into sub-steps no larger than C × criticalTimeStep"),
+		valueAttr<E>("maxSubSteps", [](E& e) -> auto& { return e.settings_.maxSubSteps; }, "Most sub-steps one O.dt may be split into [-], ≥ 1: an O.dt that would need more (a mistyped step, e.g. 10 s for a 1e-4 s critical step) is refused before any work, naming O.dt, criticalTimeStep and the sub-steps needed"),
+		valueAttr<E>("flipBlend", [](E& e) -> auto& { return e.settings_.flipBlend; }, "FLIP/PIC blend α of the grid-to-point velocity update [-], 0 ≤ α ≤ 1 (1 = pure FLIP, 0 = PIC)"),
+		valueAttr<E>("domainMin", [](E& e) -> auto& { return e.domain_.lower; }, "Lower corner of the domain box, whose faces are the walls [m]"),
+		valueAttr<E>("domainMax", [](E& e) -> auto& { return e.domain_.upper; }, "Upper corner of the domain box; each extent a whole number of cells [m]"),
+		valueAttr<E>("cellSize", [](E& e) -> auto& { return e.domain_.cellSize; }, "Cell size h of the background grid (cubic cells) [m]"),
+		optionAttr<E>("shapeFunction", [](E& e) -> auto& { return e.settings_.shapeFunction; }, shapeOptions, "Shape functions [-]: 'linear', 'uGIMP' (constant point domains) or 'cpGIMP' (domains follow the stretch)"),
+		optionAttr<E>("scheme", [](E& e) -> auto& { return e.settings_.scheme; }, schemeOptions, "Time integration of the pore pressure [-], default 'semi-implicit': the nodal pore pressure is solved implicitly each step (a projection, theory.md §8), so the step is limited by the skeleton's wave and the points' speed only, not by the water's bulk modulus or the permeability; real water (bulkModulus 2.2e9) and incompressible water (inf) cost no more. 'explicit': the pressure follows the water's volume rate point by point (theory.md §4), the step follows the undrained wave (≈20× smaller for sand with real water); it needs pressureModeDamping for long runs"),
+		valueAttr<E>("pressureTolerance", [](E& e) -> auto& { return e.settings_.pressureTolerance; }, "Accuracy of the semi-implicit pressure solve δp [Pa], > 0, default 1e-3: the conjugate gradient stops at the residual of a pressure error δp at a typical node"),
+		optionAttr<E>("drag", [](E& e) -> auto& { return e.settings_.drag; }, dragOptions, "Drag integration of the explicit scheme [-]: 'semi-implicit' (no drag time-step limit) or 'explicit'; the semi-implicit scheme always takes the drag implicitly"),
+		valueAttr<E>("cellAveraging", [](E& e) -> auto& { return e.settings_.cellAveragedVolumetricRate; }, "Cell-averaged volumetric rates for the pore pressure and the skeleton (suppresses the pressure checkerboard) [-]"),
+		valueAttr<E>("pressureModeDamping", [](E& e) -> auto& { return e.settings_.pressureModeDamping; }, "Explicit scheme only (default False; refused with scheme='semi-implicit', which needs no relaxation): pore-pressure modes the grid cannot see (cell and node checkerboards, which exert no nodal force and so are never drained) relax towards the nodal average at the rate c_v/h² at which seepage drains a one-cell perturbation (theory.md eq. 4.17b), and in wall, face and surface cells towards a local linear fit at a slower rate (eq. 4.17c); off, they can grow without bound in long runs [-]"),
+		valueAttr<E>("freeSurfaceThreshold", [](E& e) -> auto& { return e.settings_.freeSurfaceThreshold; }, "Free-surface detection β [-], 0 ≤ β < 1: water points whose filling Σ S V_water/V_full of their nodes is below β get p = 0 (0.75 keeps exactly the outer layer with 2 points per cell and axis); 0: off"),
+		valueAttr<E>("freeSurfaceHoldsSuction", [](E& e) -> auto& { return e.settings_.freeSurfaceHoldsSuction; }, "Explicit scheme only (refused with scheme='semi-implicit'). With a free surface (freeSurfaceThreshold > 0): the surface keeps suction (p < 0), as capillary menisci hold the water to the grains there (no relative flow at its nodes), and releases only positive pressure, p = min(p, 0): a seepage face that lets water out but draws none in. False: p = 0 on every free-surface point, as under ponded water [-]"),
+		optionListAttr<E>("solidWalls", 6, faces, faceItem, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].solid; }, solidWallOptions, "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0), 'fixed' or 'frictional' (a contact: pushes the grains, never pulls them, and resists sliding by Coulomb friction wallFriction × the effective normal force; a fixed wall wins on a shared edge)"),
+		optionListAttr<E>("waterWalls", 6, faces, faceItem, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].water; }, waterWallOptions, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
+		inPlace(listAttr<E>("drainedPressure", 6, faces, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].drainedPressure; }, "Uniform part of the pore pressure p̄ held on each 'drained' face [Pa]")),
+		inPlace(listAttr<E>("faceTraction", 6, faces, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].traction; }, "Traction t per face (xMin, xMax, yMin, yMax, zMin, zMax) on the mixture, e.g. (0, 0, -q) on zMax for a surface load q on a soil whose top lies on that face, integrated as a boundary traction ∮ N t dA over the face (theory.md eq. 2.8); components a solid wall holds go to the wall; changed values apply in place [Pa]")),
+		listAttr<E>("wallFriction", 6, faces, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].friction; }, "Coulomb friction coefficient μ = tan δ per 'frictional' face [-], ≥ 0"),
+		inPlace(listAttr<E>("drainedWaterTable", 6, faces, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].waterTable; }, "Per 'drained' face, the elevation of a free water surface [m] adding the hydrostatic part ρw |g| max(0, table − z) to p̄ (z measured against gravity); -inf: none")),
 		AttrSpec<E> { "waterSinks", "Boxes in which water points are removed (outflow, e.g. a filtering cloth), as a list of (lower, upper) corner pairs [m]",
 		              [](const E& e) {
 			              py::list l;
-			              for (std::size_t i = 0; i + 1 < e.waterSinks.size(); i += 2) l.append(py::make_tuple(e.waterSinks[i], e.waterSinks[i + 1]));
+			              for (const auto& sink : e.domain_.sinks) l.append(py::make_tuple(sink.lower, sink.upper));
 			              return py::object(l);
 		              },
 		              [](E& e, const py::object& v) {
-			              std::vector<yade::Vector3r> corners;
+			              std::vector<mpm::WaterSink> sinks;
 			              for (long i = 0; i < py::len(v); ++i) {
 				              if (py::len(v[i]) != 2) raisePython(PyExc_ValueError, "waterSinks entries must be (lower, upper) pairs of 3-vectors [m]");
-				              corners.push_back(toVector3("waterSinks", v[i][0]));
-				              corners.push_back(toVector3("waterSinks", v[i][1]));
+				              sinks.push_back(mpm::WaterSink { toVector3("waterSinks", v[i][0]), toVector3("waterSinks", v[i][1]) });
 			              }
-			              e.waterSinks = corners;
-		              } },
-		boolAttr("removeFreeWater", &E::removeFreeWater,
-		         "Remove water points that have left the soil (no solid in their stencil, n = 1), e.g. seepage caught by a filtering cloth; their mass counts in removedWaterMass [-]"),
-		boolAttr("removeWaterLeavingGrid", &E::removeWaterLeavingGrid, "Remove water points that leave the grid and count their mass in removedWaterMass (else the run stops) [-]"),
-		fixedListAttr("drainedWaterTable", &E::drainedWaterTable, 6,
-		              "Per 'drained' face, the elevation of a free water surface [m] adding the hydrostatic part ρw |g| max(0, table − z) to p̄ (z measured against gravity); -inf: none"),
-		boolListAttr("waterInflow", &E::waterInflow, 6, "xMin, xMax, yMin, yMax, zMin, zMax",
-		             "Per face (xMin..zMax), whether water drawn in through that 'drained' face is supplied as new water points (theory.md eq. 2.5) [-]"),
-		boolListAttr("periodic", &E::periodic, 3, "x, y, z",
-		             "Per axis (x, y, z), whether the domain repeats along it (theory.md eq. 2.7): points leaving through one face enter through the other, the two faces are no walls (their solidWalls/waterWalls must stay 'free', with no inflow, drained pressure, friction or water table) and the axis needs at least 3 cells [-]"),
-		readOnly(intAttr("stepsDone", &E::stepsDone, "Number of times the engine ran [-]")),
-		readOnly(realAttr("mpmTime", &E::mpmTime, "Total time the MPM state was advanced [s]")),
-		readOnly(intAttr("lastIter", &E::lastIter, "O.iter seen by the last run of the engine [-]")),
-		readOnly(realAttr("lastDt", &E::lastDt, "O.dt seen by the last run of the engine [s]")),
-		readOnly(intAttr("solidPointCount", &E::solidPointCount, "Solid points advanced by the last run [-]")),
-		readOnly(intAttr("waterPointCount", &E::waterPointCount, "Water points advanced by the last run [-]")),
-		readOnly(intAttr("subStepsLast", &E::subStepsLast, "Explicit sub-steps taken by the last run [-]")),
-		readOnly(intAttr("solverSteps", &E::solverSteps, "Explicit steps since the solver was (re)built [-]")),
-		readOnly(realAttr("removedWaterMass", &E::removedWaterMass, "Water mass removed by waterSinks and at the grid's edge since the start [kg]")),
-		readOnly(realAttr("injectedWaterMass", &E::injectedWaterMass, "Water mass supplied as new water points through waterInflow faces since the start [kg]")),
-		readOnly(intAttr("pressureSolveIterations", &E::pressureSolveIterations, "Conjugate-gradient iterations of the last pressure solve of the semi-implicit scheme [-]")),
-		readOnly(realAttr("criticalTimeStep", &E::criticalTimeStep,
-		                  "Critical time step of the last run before timeStepFactor [s]: semi-implicit, h/(skeleton wave + fastest point) (theory.md eq. 8.10); explicit, min of h/(fastest wave + fastest point) and, with explicit drag, the drag limit (eqs. 5.1–5.2)")),
-	};
+			              e.domain_.sinks = sinks;
+		              },
+		              archiver<E>([](auto& ar, E& e) { // (lower, upper) corner pairs
+			              std::vector<yade::Vector3r> corners;
+			              for (const auto& sink : e.domain_.sinks) corners.insert(corners.end(), { sink.lower, sink.upper });
+			              serializeFlat(ar, "waterSinks", corners);
+			              if constexpr (std::decay_t<decltype(ar)>::is_loading::value) {
+				              e.domain_.sinks.clear();
+				              for (std::size_t i = 0; i + 1 < corners.size(); i += 2) e.domain_.sinks.push_back(mpm::WaterSink { corners[i], corners[i + 1] });
+			              }
+		              }) },
+		valueAttr<E>("removeWaterLeavingGrid", [](E& e) -> auto& { return e.domain_.removeWaterLeavingGrid; }, "Remove water points that leave the grid and count their mass in removedWaterMass (else the run stops) [-]"),
+		valueAttr<E>("removeFreeWater", [](E& e) -> auto& { return e.domain_.removeFreeWater; }, "Remove water points that have left the soil (no solid in their stencil, n = 1), e.g. seepage caught by a filtering cloth; their mass counts in removedWaterMass [-]"),
+		listAttr<E>("waterInflow", 6, faces, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].inflow; }, "Per face (xMin..zMax), whether water drawn in through that 'drained' face is supplied as new water points (theory.md eq. 2.5) [-]"),
+		listAttr<E>("periodic", 3, "x, y, z", [](E& e, int axis) -> auto& { return e.domain_.boundaries.periodic[axis]; }, "Per axis (x, y, z), whether the domain repeats along it (theory.md eq. 2.7): points leaving through one face enter through the other, the two faces are no walls (their solidWalls/waterWalls must stay 'free', with no inflow, drained pressure, friction or water table) and the axis needs at least 3 cells [-]"),
+		readOnly(valueAttr<E>("removedWaterMass", member(&E::removedWaterMass), "Water mass removed by waterSinks and at the grid's edge since the start [kg]")),
+		readOnly(valueAttr<E>("injectedWaterMass", member(&E::injectedWaterMass), "Water mass supplied as new water points through waterInflow faces since the start [kg]")),
+		readOnly(valueAttr<E>("stepsDone", member(&E::stepsDone), "Number of times the engine ran [-]")),
+		readOnly(valueAttr<E>("mpmTime", member(&E::mpmTime), "Total time the MPM state was advanced [s]")),
+		readOnly(valueAttr<E>("lastIter", member(&E::lastIter), "O.iter seen by the last run of the engine [-]")),
+		readOnly(valueAttr<E>("lastDt", member(&E::lastDt), "O.dt seen by the last run of the engine [s]")),
+		readOnly(valueAttr<E>("solidPointCount", member(&E::solidPointCount), "Solid points advanced by the last run [-]")),
+		readOnly(valueAttr<E>("waterPointCount", member(&E::waterPointCount), "Water points advanced by the last run [-]")),
+		readOnly(valueAttr<E>("subStepsLast", member(&E::subStepsLast), "Explicit sub-steps taken by the last run [-]")),
+		readOnly(valueAttr<E>("solverSteps", member(&E::solverSteps), "Explicit steps since the solver was (re)built [-]")),
+		readOnly(valueAttr<E>("criticalTimeStep", member(&E::criticalTimeStep), "Critical time step of the last run before timeStepFactor [s]: semi-implicit, h/(skeleton wave + fastest point) (theory.md eq. 8.10); explicit, min of h/(fastest wave + fastest point) and, with explicit drag, the drag limit (eqs. 5.1–5.2)")),
+		readOnly(valueAttr<E>("pressureSolveIterations", member(&E::pressureSolveIterations), "Conjugate-gradient iterations of the last pressure solve of the semi-implicit scheme [-]")),
+		};
+		for (auto& spec : t)
+			if (spec.set && !spec.inPlace) spec.set = [set = spec.set](E& e, const py::object& v) {
+				set(e, v);
+				e.solverStale_ = true;
+			};
+		return t;
+	}();
 	return table;
 }
 
@@ -352,53 +294,6 @@ void MpmTwoPhaseEngine::pyRegisterClass(py::object scope)
 {
 	registerPythonClass<MpmTwoPhaseEngine, yade::GlobalEngine>(
 	        scope, "Advances every MPM body of the scene (shapes MpmSolidPoints and MpmWaterPoints, materials MpmSoilMat and MpmWaterMat) by O.dt per step: the fully coupled two-phase material point method on a regular grid over the box domainMin..domainMax, whose faces are walls with per-phase conditions.");
-}
-
-template <class Archive> void MpmTwoPhaseEngine::serialize(Archive& ar, unsigned int)
-{
-	ar& boost::serialization::make_nvp("GlobalEngine", boost::serialization::base_object<yade::GlobalEngine>(*this));
-	serializeVector3(ar, "gravity", gravity);
-	ar& BOOST_SERIALIZATION_NVP(timeStepFactor);
-	ar& BOOST_SERIALIZATION_NVP(maxSubSteps);
-	ar& BOOST_SERIALIZATION_NVP(flipBlend);
-	serializeVector3(ar, "domainMin", domainMin);
-	serializeVector3(ar, "domainMax", domainMax);
-	ar& BOOST_SERIALIZATION_NVP(cellSize);
-	ar& BOOST_SERIALIZATION_NVP(shapeFunction);
-	ar& BOOST_SERIALIZATION_NVP(scheme);
-	ar& BOOST_SERIALIZATION_NVP(pressureTolerance);
-	ar& BOOST_SERIALIZATION_NVP(drag);
-	ar& BOOST_SERIALIZATION_NVP(cellAveraging);
-	ar& BOOST_SERIALIZATION_NVP(pressureModeDamping);
-	ar& BOOST_SERIALIZATION_NVP(freeSurfaceThreshold);
-	ar& BOOST_SERIALIZATION_NVP(freeSurfaceHoldsSuction);
-	ar& BOOST_SERIALIZATION_NVP(solidWalls);
-	ar& BOOST_SERIALIZATION_NVP(waterWalls);
-	ar& BOOST_SERIALIZATION_NVP(drainedPressure);
-	serializeFlat(ar, "faceTraction", faceTraction);
-	ar& BOOST_SERIALIZATION_NVP(wallFriction);
-	ar& BOOST_SERIALIZATION_NVP(drainedWaterTable);
-	serializeFlat(ar, "waterSinks", waterSinks);
-	ar& BOOST_SERIALIZATION_NVP(removeWaterLeavingGrid);
-	ar& BOOST_SERIALIZATION_NVP(removeFreeWater);
-	ar& BOOST_SERIALIZATION_NVP(waterInflow);
-	ar& BOOST_SERIALIZATION_NVP(periodic);
-	ar& BOOST_SERIALIZATION_NVP(removedWaterMass);
-	ar& BOOST_SERIALIZATION_NVP(injectedWaterMass);
-	if (Archive::is_loading::value) {
-		removedBefore_  = removedWaterMass;
-		injectedBefore_ = injectedWaterMass;
-	}
-	ar& BOOST_SERIALIZATION_NVP(stepsDone);
-	ar& BOOST_SERIALIZATION_NVP(mpmTime);
-	ar& BOOST_SERIALIZATION_NVP(lastIter);
-	ar& BOOST_SERIALIZATION_NVP(lastDt);
-	ar& BOOST_SERIALIZATION_NVP(solidPointCount);
-	ar& BOOST_SERIALIZATION_NVP(waterPointCount);
-	ar& BOOST_SERIALIZATION_NVP(subStepsLast);
-	ar& BOOST_SERIALIZATION_NVP(solverSteps);
-	ar& BOOST_SERIALIZATION_NVP(criticalTimeStep);
-	ar& BOOST_SERIALIZATION_NVP(pressureSolveIterations);
 }
 
 } // namespace yade_mpm

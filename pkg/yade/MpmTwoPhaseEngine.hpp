@@ -8,43 +8,16 @@
 
 #include "../core/TwoPhaseSolver.hpp"
 
-#include <limits>
 #include <memory>
-#include <tuple>
 
 namespace yade_mpm {
 
+// Its inputs are stored in the core's own SolverSettings and Domain; each attribute is declared once,
+// in the table of MpmTwoPhaseEngine.cpp (Python name, unit, range, docstring, saved form, and whether a
+// change applies in place or rebuilds the solver).
 class MpmTwoPhaseEngine : public yade::GlobalEngine {
 public:
-	// inputs
-	yade::Vector3r gravity        = yade::Vector3r::Zero(); // b [m s⁻²], body acceleration of both phases
-	yade::Real     timeStepFactor = 0.5;                    // C [-] in (0, 1]: safety factor on the critical step
-	long           maxSubSteps    = 100000;                 // [-] ≥ 1: most sub-steps one O.dt may take
-	yade::Real     flipBlend      = 1.0;                    // α [-] in [0, 1]: 1 = FLIP, 0 = PIC
-	yade::Vector3r domainMin      = yade::Vector3r::Zero(); // lower corner of the domain box (walls) [m]
-	yade::Vector3r domainMax      = yade::Vector3r::Ones(); // upper corner [m]
-	yade::Real     cellSize       = 0.1;                    // h [m]
-	std::string    shapeFunction  = "uGIMP";                // linear | uGIMP | cpGIMP
-	std::string    scheme         = "semi-implicit";        // semi-implicit | explicit (pore pressure; theory.md §8, §4)
-	yade::Real     pressureTolerance = 1e-3;                // δp [Pa] > 0: accuracy of the semi-implicit pressure solve
-	std::string    drag           = "semi-implicit";        // semi-implicit | explicit
-	bool           cellAveraging  = true;                   // cell-averaged volumetric rates
-	bool           pressureModeDamping = false;             // explicit scheme only: grid-invisible pressure modes decay (theory.md eq. 4.17b)
-	yade::Real     freeSurfaceThreshold = 0;                // β [-]: p = 0 on water points filled below β; 0 off
-	bool           freeSurfaceHoldsSuction = false;         // the free surface keeps suction, releases only p > 0 (seepage face)
-	std::vector<std::string> solidWalls { 6, "free" };      // per face xMin..zMax: free | slip | fixed | frictional
-	std::vector<std::string> waterWalls { 6, "free" };      // free | impermeable | drained
-	std::vector<yade::Real>  drainedPressure = std::vector<yade::Real>(6, 0.0); // p̄ per face [Pa]
-	std::vector<yade::Vector3r> faceTraction = std::vector<yade::Vector3r>(6, yade::Vector3r::Zero()); // t per face [Pa]
-	std::vector<yade::Real>  wallFriction    = std::vector<yade::Real>(6, 0.0); // μ per 'frictional' face [-]
-	std::vector<yade::Vector3r> waterSinks;             // (lower, upper) corner pairs of sink boxes [m]
-	bool                        removeWaterLeavingGrid = true; // water leaving the grid is removed (else: stop)
-	bool                        removeFreeWater        = false; // water points with no solid in their stencil are removed
-	std::vector<yade::Real>  drainedWaterTable = std::vector<yade::Real>(6, -std::numeric_limits<yade::Real>::infinity()); // [m], -inf: none
-	std::vector<int>         waterInflow = std::vector<int>(6, 0); // per face: water points enter through this drained face
-	std::vector<int>         periodic    = std::vector<int>(3, 0); // per axis x, y, z: the domain repeats along it (faces stay free)
-
-	// outputs (read-only from Python)
+	// outputs (read-only from Python, saved with the scene)
 	long       stepsDone       = 0; // number of times action() ran [-]
 	yade::Real mpmTime         = 0; // total time the MPM state was advanced [s]
 	long       lastIter        = -1; // O.iter seen by the last action() [-]
@@ -63,30 +36,27 @@ public:
 	// Advances every MPM body by O.dt in sub-steps; Ctrl-C ends it after the sub-step in progress,
 	// with O.time = mpmTime, and pauses the run (SigintWindow.hpp).
 	void action() override;
+	// Validates the inputs (ValueError naming the attribute); a change of any input but the values
+	// held on the faces rebuilds the solver at the next step.
 	void callPostLoad() override;
 	void pyRegisterClass(boost::python::object scope) override;
-	template <class Archive> void serialize(Archive& ar, unsigned int version);
 	MPM_SERIALIZABLE_OVERRIDES(MpmTwoPhaseEngine, GlobalEngine)
 
-	// Core objects built from the attributes (validated); rebuilt after any attribute change.
-	mpm::Domain         domain() const;
-	mpm::SolverSettings settings() const;
+	const mpm::SolverSettings& settings() const { return settings_; }
+	mpm::Domain                domain() const; // validated: InvalidParameter in the Python names
 	const mpm::TwoPhaseSolver* solver() const { return solver_.get(); }
 
 private:
 	void stopAfterInterrupt(yade::Real dt, const mpm::AdvanceReport& advanced);
-	// Everything the solver is built from except the values held on drained faces, which a
-	// running solver takes over in place (a rising head set every step must not rebuild it).
-	using Structure = std::tuple<std::string, yade::Real, yade::Vector3r, yade::Real, yade::Real, yade::Vector3r, yade::Vector3r, yade::Real, std::string, std::string, bool, bool, yade::Real, bool,
-	                             std::vector<std::string>, std::vector<yade::Real>, std::vector<std::string>, std::vector<yade::Vector3r>, bool, bool, std::vector<int>, std::vector<int>, long>;
-	Structure structure() const;
 	// Before any work, over O.engines: refuses another active MpmTwoPhaseEngine (issue 17 item 2) and
 	// a recorder file that cannot or must not be written (item 5); returns how to name an active
 	// NewtonIntegrator ("" if none), under which MPM bodies must not be dynamic (item 4).
 	std::string checkOtherEngines() const;
 
+	mpm::SolverSettings                  settings_;           // the inputs of the solver's settings
+	mpm::Domain                          domain_;             // the box, grid, walls, faces and sinks
+	bool                                 solverStale_ = true; // an input that needs a rebuild was set
 	std::unique_ptr<mpm::TwoPhaseSolver> solver_;  // not serialized: rebuilt on first action()
-	Structure                            builtFor_ {};
 	yade::Real                           removedBefore_  = 0; // removed by solvers before the current one [kg]
 	yade::Real                           injectedBefore_ = 0; // injected by solvers before the current one [kg]
 };

@@ -94,6 +94,7 @@ AttrSpec<Owner> pointArrayAttr(const char* name, PointSet Owner::*points, std::v
 			                    + " points (assign 'pos' first: it defines the number of points)");
 		fromRowMajor(name, flat, set.*field);
 	};
+	spec.archive = archiver<Owner>([points, field, name](auto& ar, Owner& s) { serializeFlat(ar, name, (s.*points).*field); });
 	return spec;
 }
 

@@ -4,11 +4,15 @@
 // per-point Python objects.
 #pragma once
 
+#include "Serialization.hpp"
 #include "YadeAbi.hpp"
 
 #include <boost/python/raw_function.hpp>
 
+#include <array>
 #include <functional>
+#include <type_traits>
+#include <utility>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -26,14 +30,41 @@ namespace py = boost::python;
 	throw std::logic_error("unreachable"); // throw_error_already_set never returns
 }
 
+// How O.save/O.load store one attribute: the same action for each archive YADE uses (binary for
+// .yade/.gz/.bz2 and O.saveTmp, xml for .xml), built from one generic lambda (auto& ar, T&).
+template <class T> struct Archiver {
+	std::function<void(boost::archive::binary_oarchive&, T&)> binaryOut;
+	std::function<void(boost::archive::binary_iarchive&, T&)> binaryIn;
+	std::function<void(boost::archive::xml_oarchive&, T&)>    xmlOut;
+	std::function<void(boost::archive::xml_iarchive&, T&)>    xmlIn;
+	explicit operator bool() const { return static_cast<bool>(binaryOut); }
+	void     operator()(boost::archive::binary_oarchive& ar, T& s) const { binaryOut(ar, s); }
+	void     operator()(boost::archive::binary_iarchive& ar, T& s) const { binaryIn(ar, s); }
+	void     operator()(boost::archive::xml_oarchive& ar, T& s) const { xmlOut(ar, s); }
+	void     operator()(boost::archive::xml_iarchive& ar, T& s) const { xmlIn(ar, s); }
+};
+template <class T, class F> Archiver<T> archiver(F f) { return { f, f, f, f }; }
+
+// One attribute, declared once: Python name, docstring (unit in [...], range; the default is
+// appended at registration), how Python reads and writes it, how it is stored in a saved scene,
+// and for engine inputs whether a change applies to a running solver in place.
 template <class T> struct AttrSpec {
 	std::string                                      name;
 	std::string                                      doc;
 	std::function<py::object(const T&)>              get;
-	std::function<void(T&, const py::object& value)> set; // empty: read-only
+	std::function<void(T&, const py::object& value)> set;     // empty: read-only
+	Archiver<T>                                      archive; // empty: not saved
+	bool                                             inPlace = false; // MpmTwoPhaseEngine inputs: false = a change rebuilds the solver
 };
 
 template <class T> using AttrTable = std::vector<AttrSpec<T>>;
+
+// The table drives serialization: every saved attribute, in table order.
+template <class Archive, class T> void serializeAttributes(Archive& ar, T& self)
+{
+	for (const auto& spec : T::attributes())
+		if (spec.archive) spec.archive(ar, self);
+}
 
 // --- scalar conversions with named errors ---------------------------------------------------
 inline double toReal(const std::string& name, const py::object& value)
@@ -49,6 +80,24 @@ inline yade::Vector3r toVector3(const std::string& name, const py::object& value
 	for (int i = 0; i < 3; ++i) v[i] = toReal(name, value[i]);
 	return v;
 }
+inline long toInteger(const std::string& name, const py::object& value)
+{
+	py::extract<long> x(value);
+	if (!x.check()) raisePython(PyExc_TypeError, "attribute '" + name + "' expects an integer");
+	return x();
+}
+inline bool toBool(const std::string& name, const py::object& value)
+{
+	py::extract<bool> x(value);
+	if (!x.check()) raisePython(PyExc_TypeError, "attribute '" + name + "' expects True or False");
+	return x();
+}
+inline std::string toString(const std::string& name, const py::object& value)
+{
+	py::extract<std::string> x(value);
+	if (!x.check()) raisePython(PyExc_TypeError, "attribute '" + name + "' expects a string");
+	return x();
+}
 
 // --- numpy bridge -----------------------------------------------------------------------------
 // Copy `count` doubles into a new numpy array of the given shape.
@@ -57,81 +106,171 @@ py::object numpyFromDoubles(const double* data, std::size_t count, const std::ve
 // trailing dimensions must equal `trailingShape`. Returns the number of rows.
 std::size_t doublesFromNumpy(const std::string& name, const py::object& value, const std::vector<std::size_t>& trailingShape, std::vector<double>& out);
 
+// --- values: Python conversion and archive form per C++ type ------------------------------------
+template <class V> V fromPython(const std::string& name, const py::object& value)
+{
+	if constexpr (std::is_same_v<V, bool>) return toBool(name, value);
+	else if constexpr (std::is_integral_v<V>) return static_cast<V>(toInteger(name, value));
+	else if constexpr (std::is_floating_point_v<V>) return toReal(name, value);
+	else if constexpr (std::is_same_v<V, std::string>) return toString(name, value);
+	else {
+		static_assert(std::is_same_v<V, yade::Vector3r>, "unsupported attribute type");
+		return toVector3(name, value);
+	}
+}
+// Vectors cross as plain tuples of floats, like the per-face lists.
+template <class V> py::object toPython(const V& v)
+{
+	if constexpr (std::is_same_v<V, yade::Vector3r>) return py::make_tuple(v[0], v[1], v[2]);
+	else return py::object(v);
+}
+template <class Archive, class V> void archiveValue(Archive& ar, const char* name, V& v)
+{
+	if constexpr (std::is_same_v<V, yade::Vector3r>) serializeVector3(ar, name, v);
+	else ar& boost::serialization::make_nvp(name, v);
+}
+
+// A named choice stored as a core enum; Python and saved scenes see the name.
+template <class Enum, std::size_t N> using Options = std::array<std::pair<const char*, Enum>, N>;
+template <class Enum, std::size_t N> Enum parseOption(const std::string& attribute, const std::string& value, const Options<Enum, N>& options)
+{
+	std::string valid;
+	for (const auto& [name, e] : options) {
+		if (value == name) return e;
+		valid += (valid.empty() ? "" : ", ") + std::string(name);
+	}
+	raisePython(PyExc_ValueError, attribute + " = '" + value + "' is not one of: " + valid);
+}
+template <class Enum, std::size_t N> std::string optionName(Enum value, const Options<Enum, N>& options)
+{
+	for (const auto& [name, e] : options)
+		if (e == value) return name;
+	return "?";
+}
+
 // --- table builders -----------------------------------------------------------------------------
-template <class T, class M> AttrSpec<T> realAttr(const char* name, M T::*member, const char* doc)
+// `access` returns a reference to the storage: a member of the class or of a core struct it holds
+// (e.g. [](E& e) -> auto& { return e.settings_.flipBlend; }); `member(&T::x)` makes one.
+template <class T, class M> auto member(M T::*m)
 {
-	return { name, doc, [member](const T& s) { return py::object(s.*member); }, [member, name](T& s, const py::object& v) { s.*member = toReal(name, v); } };
+	return [m](T& s) -> M& { return s.*m; };
 }
-template <class T, class M> AttrSpec<T> intAttr(const char* name, M T::*member, const char* doc)
+
+// A scalar or 3-vector (Vector3r reads back as YADE's Vector3).
+template <class T, class Access> AttrSpec<T> valueAttr(const char* name, Access access, const char* doc)
 {
-	return { name, doc, [member](const T& s) { return py::object(s.*member); }, [member, name](T& s, const py::object& v) {
-		        py::extract<long> x(v);
-		        if (!x.check()) raisePython(PyExc_TypeError, std::string("attribute '") + name + "' expects an integer");
-		        s.*member = static_cast<M>(x());
-	        } };
+	using V = std::decay_t<decltype(access(std::declval<T&>()))>;
+	AttrSpec<T> spec;
+	spec.name    = name;
+	spec.doc     = doc;
+	spec.get     = [access](const T& s) { return py::object(access(const_cast<T&>(s))); };
+	spec.set     = [access, name](T& s, const py::object& v) { access(s) = fromPython<V>(name, v); };
+	spec.archive = archiver<T>([access, name](auto& ar, T& s) { archiveValue(ar, name, access(s)); });
+	return spec;
 }
-template <class T> AttrSpec<T> boolAttr(const char* name, bool T::*member, const char* doc)
+// Member-pointer shorthands for the plain classes.
+template <class T, class M> AttrSpec<T> realAttr(const char* name, M T::*m, const char* doc) { return valueAttr<T>(name, member(m), doc); }
+template <class T, class M> AttrSpec<T> intAttr(const char* name, M T::*m, const char* doc) { return valueAttr<T>(name, member(m), doc); }
+template <class T> AttrSpec<T> boolAttr(const char* name, bool T::*m, const char* doc) { return valueAttr<T>(name, member(m), doc); }
+template <class T> AttrSpec<T> stringAttr(const char* name, std::string T::*m, const char* doc) { return valueAttr<T>(name, member(m), doc); }
+
+// A named choice (core enum).
+template <class T, class Access, class Enum, std::size_t N>
+AttrSpec<T> optionAttr(const char* name, Access access, const Options<Enum, N>& options, const char* doc)
 {
-	return { name, doc, [member](const T& s) { return py::object(s.*member); }, [member](T& s, const py::object& v) { s.*member = py::extract<bool>(v)(); } };
+	AttrSpec<T> spec;
+	spec.name    = name;
+	spec.doc     = doc;
+	spec.get     = [access, &options](const T& s) { return py::object(optionName(access(const_cast<T&>(s)), options)); };
+	spec.set     = [access, name, &options](T& s, const py::object& v) { access(s) = parseOption(name, toString(name, v), options); };
+	spec.archive = archiver<T>([access, name, &options](auto& ar, T& s) {
+		std::string value = optionName(access(s), options);
+		archiveValue(ar, name, value);
+		if constexpr (std::decay_t<decltype(ar)>::is_loading::value) access(s) = parseOption(name, value, options);
+	});
+	return spec;
 }
-template <class T> AttrSpec<T> vector3Attr(const char* name, yade::Vector3r T::*member, const char* doc)
+
+// One entry per item (a face of the domain box, an axis): `access(s, i)` returns item i's storage;
+// Python sees a tuple of `count` values (`items` names them in messages), a saved scene a vector.
+// Values are converted and checked all before any is stored.
+template <class T, class Access>
+AttrSpec<T> listAttr(const char* name, int count, const char* items, Access access, const char* doc)
 {
-	return { name, doc, [member](const T& s) { return py::object(s.*member); }, [member, name](T& s, const py::object& v) { s.*member = toVector3(name, v); } };
+	using V      = std::decay_t<decltype(access(std::declval<T&>(), 0))>;
+	using Stored = std::conditional_t<std::is_same_v<V, bool>, int, V>; // std::vector<bool> has no element references
+	AttrSpec<T> spec;
+	spec.name = name;
+	spec.doc  = doc;
+	spec.get  = [access, count](const T& s) {
+                py::list l;
+                for (int i = 0; i < count; ++i) l.append(toPython<V>(access(const_cast<T&>(s), i)));
+                return py::object(py::tuple(l));
+	};
+	spec.set = [access, name, count, items](T& s, const py::object& v) {
+		if (py::len(v) != count)
+			raisePython(PyExc_ValueError, std::string("attribute '") + name + "' expects " + std::to_string(count) + " entries (" + items + ")");
+		std::vector<V> values;
+		for (int i = 0; i < count; ++i) values.push_back(fromPython<V>(std::string(name) + "[" + std::to_string(i) + "]", v[i]));
+		for (int i = 0; i < count; ++i) access(s, i) = values[i];
+	};
+	spec.archive = archiver<T>([access, name, count](auto& ar, T& s) {
+		std::vector<Stored> values;
+		for (int i = 0; i < count; ++i) values.push_back(static_cast<Stored>(access(s, i)));
+		if constexpr (std::is_same_v<V, yade::Vector3r>) serializeFlat(ar, name, values);
+		else ar& boost::serialization::make_nvp(name, values);
+		if constexpr (std::decay_t<decltype(ar)>::is_loading::value)
+			for (int i = 0; i < count && i < static_cast<int>(values.size()); ++i) access(s, i) = static_cast<V>(values[i]);
+	});
+	return spec;
 }
-template <class T> AttrSpec<T> stringAttr(const char* name, std::string T::*member, const char* doc)
+// The same with a named choice per item; `itemName(i)` names an item in messages (e.g. "xMin").
+template <class T, class Access, class Enum, std::size_t N, class ItemName>
+AttrSpec<T> optionListAttr(const char* name, int count, const char* items, ItemName itemName, Access access, const Options<Enum, N>& options, const char* doc)
 {
-	return { name, doc, [member](const T& s) { return py::object(s.*member); }, [member, name](T& s, const py::object& v) {
-		        py::extract<std::string> x(v);
-		        if (!x.check()) raisePython(PyExc_TypeError, std::string("attribute '") + name + "' expects a string");
-		        s.*member = x();
-	        } };
+	AttrSpec<T> spec;
+	spec.name = name;
+	spec.doc  = doc;
+	spec.get  = [access, count, &options](const T& s) {
+                py::list l;
+                for (int i = 0; i < count; ++i) l.append(optionName(access(const_cast<T&>(s), i), options));
+                return py::object(py::tuple(l));
+	};
+	spec.set = [access, name, count, items, itemName, &options](T& s, const py::object& v) {
+		if (py::len(v) != count)
+			raisePython(PyExc_ValueError, std::string("attribute '") + name + "' expects " + std::to_string(count) + " entries (" + items + ")");
+		std::vector<Enum> values;
+		for (int i = 0; i < count; ++i) {
+			const std::string entry = std::string(name) + "[" + itemName(i) + "]";
+			values.push_back(parseOption(entry, toString(entry, v[i]), options));
+		}
+		for (int i = 0; i < count; ++i) access(s, i) = values[i];
+	};
+	spec.archive = archiver<T>([access, name, count, itemName, &options](auto& ar, T& s) {
+		std::vector<std::string> values;
+		for (int i = 0; i < count; ++i) values.push_back(optionName(access(s, i), options));
+		ar& boost::serialization::make_nvp(name, values);
+		if constexpr (std::decay_t<decltype(ar)>::is_loading::value)
+			for (int i = 0; i < count && i < static_cast<int>(values.size()); ++i) access(s, i) = parseOption(std::string(name) + "[" + itemName(i) + "]", values[i], options);
+	});
+	return spec;
 }
-// A fixed-length list (e.g. one entry per face of the domain box) of strings or reals.
-template <class T, class E> AttrSpec<T> fixedListAttr(const char* name, std::vector<E> T::*member, std::size_t length, const char* doc)
-{
-	return { name, doc,
-		 [member](const T& s) {
-			 py::list l;
-			 for (const auto& e : s.*member) l.append(e);
-			 return py::object(py::tuple(l));
-		 },
-		 [member, name, length](T& s, const py::object& v) {
-			 if (py::len(v) != static_cast<long>(length))
-				 raisePython(PyExc_ValueError, std::string("attribute '") + name + "' expects " + std::to_string(length) + " entries (xMin, xMax, yMin, yMax, zMin, zMax)");
-			 std::vector<E> out;
-			 for (std::size_t i = 0; i < length; ++i) {
-				 py::extract<E> x(v[i]);
-				 if (!x.check()) raisePython(PyExc_TypeError, std::string("attribute '") + name + "' has an entry of the wrong type at index " + std::to_string(i));
-				 out.push_back(x());
-			 }
-			 s.*member = out;
-		 } };
-}
-// A fixed-length list of booleans stored as ints (std::vector<bool> has no element references);
-// `entries` names them in the error message, e.g. "x, y, z".
-template <class T> AttrSpec<T> boolListAttr(const char* name, std::vector<int> T::*member, std::size_t length, const char* entries, const char* doc)
-{
-	return { name, doc,
-		 [member](const T& s) {
-			 py::list l;
-			 for (int on : s.*member) l.append(on != 0);
-			 return py::object(py::tuple(l));
-		 },
-		 [member, name, length, entries](T& s, const py::object& v) {
-			 if (py::len(v) != static_cast<long>(length))
-				 raisePython(PyExc_ValueError, std::string("attribute '") + name + "' expects " + std::to_string(length) + " entries (" + entries + ")");
-			 std::vector<int> out;
-			 for (std::size_t i = 0; i < length; ++i) {
-				 py::extract<bool> b(v[i]);
-				 if (!b.check()) raisePython(PyExc_TypeError, std::string("attribute '") + name + "' has a non-boolean entry at index " + std::to_string(i));
-				 out.push_back(b() ? 1 : 0);
-			 }
-			 s.*member = out;
-		 } };
-}
+
 template <class T> AttrSpec<T> readOnly(AttrSpec<T> spec)
 {
 	spec.set = nullptr;
+	return spec;
+}
+// Not stored by the table (YADE's base class saves it, e.g. Material::density; or derived data)
+template <class T> AttrSpec<T> notSaved(AttrSpec<T> spec)
+{
+	spec.archive = {};
+	return spec;
+}
+// An engine input whose change a running solver takes over without a rebuild
+template <class T> AttrSpec<T> inPlace(AttrSpec<T> spec)
+{
+	spec.inPlace = true;
 	return spec;
 }
 

@@ -295,5 +295,5 @@ def test_periodic_axis_refuses_walls_on_its_faces():
         engine.waterWalls = ("drained",) + ("free",) * 5
     with pytest.raises(ValueError, match=r"'periodic' expects 3 entries \(x, y, z\)"):
         engine.periodic = (True, False)
-    with pytest.raises(TypeError, match=r"'periodic' has a non-boolean entry at index 2"):
+    with pytest.raises(TypeError, match=r"'periodic\[2\]' expects True or False"):
         engine.periodic = (True, False, "yes")
