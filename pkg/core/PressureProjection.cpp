@@ -125,20 +125,18 @@ namespace stages {
 			}
 		}
 		system.rows.assign(system.node.size() * PressureSystem::rowStride, 0);
-		system.porosityGradient.resize(sets.size());
 		const Real invKw = 1 / water.bulkModulus; // 0 for incompressible water (Kw = ∞)
 		for (std::size_t s = 0; s < sets.size(); ++s) {
 			const WaterPointSet& P     = *sets[s];
-			std::vector<Vec3>&   gradN = system.porosityGradient[s];
-			gradN.resize(P.size());
 			scatter(system.rows, system.rowBuffers, P.size(), [&](std::size_t p, Real* rows) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
 				int node[3][S];
 				stencilNodes(grid, w, node);
-				// the solid fields at the water point (eqs. 4.5, 8.5) and the predicted velocities
+				// the porosity and mobility at the water point (eqs. 4.5, 8.5) and the divergence of the
+				// predicted water velocity
 				Real n = 0, divW = 0;
-				Vec3 gradn = Vec3::Zero(), vw = Vec3::Zero(), lambda = Vec3::Zero();
+				Vec3 lambda = Vec3::Zero();
 				Real N[S][S][S];
 				Vec3 dN[S][S][S];
 				for (int c = 0; c < S; ++c)
@@ -150,16 +148,14 @@ namespace stages {
 							const std::size_t I  = grid.index(node[0][a], node[1][b], node[2][c]);
 							const Real        Ni = N[c][b][a];
 							n += Ni * fields.porosity[I];
-							gradn += fields.porosity[I] * dN[c][b][a];
 							lambda += Ni * system.mobility[I];
-							vw += Ni * fields.waterVelocityNew[I];
 							divW += fields.waterVelocityNew[I].dot(dN[c][b][a]);
 						}
 				n        = std::clamp<Real>(n, 1e-5, 1);
-				gradN[p] = gradn;
 				const Real V = P.volume[p];
-				// eq. 8.2, the water's share: n∇·vw + vw·∇n (the solid's is added at the solid points below)
-				const Real divergence = n * divW + vw.dot(gradn);
+				// eq. 8.2, the water's share n∇·vw (the exchange term vw·∇n and the solid's share are
+				// added at the solid points below)
+				const Real divergence = n * divW;
 				const Real storage    = V * n * invKw / dt; // C/Δt (eq. 8.3), consistent: Σ V S_J S_K n/(Kw Δt)
 				const Vec3 conductance = dt * V * lambda;    // Δt L (eq. 8.6), per axis
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n
@@ -193,17 +189,20 @@ namespace stages {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
 				Real n = 0, divS = 0;
-				Vec3 gradn = Vec3::Zero(), vs = Vec3::Zero();
+				Vec3 gradn = Vec3::Zero(), vs = Vec3::Zero(), vw = Vec3::Zero();
 				bool reaches = false;
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 					n += N * fields.porosity[I];
 					gradn += fields.porosity[I] * dN;
 					vs += N * fields.solidVelocityNew[I];
+					vw += N * fields.waterVelocityNew[I];
 					divS += fields.solidVelocityNew[I].dot(dN);
 					reaches = reaches || system.row[I] >= 0;
 				});
 				if (!reaches) return;
-				const Real source = P.volume[p] * ((1 - n) * divS - vs.dot(gradn));
+				// (1 − n)∇·vs + (vw − vs)·∇n: the exchange term of both phases where ∇n is, at the
+				// skeleton's points, so that the pressure forces it is adjoint to sum to zero
+				const Real source = P.volume[p] * ((1 - n) * divS + (vw - vs).dot(gradn));
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 					if (system.row[I] >= 0) rows[static_cast<std::size_t>(system.row[I]) * PressureSystem::rowStride + PressureSystem::rhsSlot] -= N * source;
 				});
@@ -346,7 +345,6 @@ namespace stages {
 		system.forces.assign(grid.nodeCount(), zeroOf(PressureForceNode {}));
 		for (std::size_t s = 0; s < sets.size(); ++s) {
 			WaterPointSet&           P     = *sets[s];
-			const std::vector<Vec3>& gradN = system.porosityGradient[s];
 			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
@@ -354,9 +352,8 @@ namespace stages {
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) { q += N * pressure[I]; });
 				P.porePressure[p] = q; // S4a: p^{n+1} at the point, with the weights of t^n
 				const Real n = P.porosity[p], Vq = P.volume[p] * q;
-				const Vec3 gn = gradN[p];
-				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
-					nodes[I].water += Vq * (n * dN + N * gn); // eq. 8.1: ∇(n S_I)
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) {
+					nodes[I].water += Vq * n * dN; // eq. 8.1: n ∇S_I (the exchange S_I ∇n at the solid points)
 				});
 			});
 		}
@@ -374,7 +371,10 @@ namespace stages {
 					gn += fields.porosity[I] * dN;
 				});
 				const Real Vq = P.volume[p] * q;
-				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) { nodes[I].solid += Vq * ((1 - n) * dN - N * gn); });
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					nodes[I].solid += Vq * ((1 - n) * dN - N * gn);
+					nodes[I].water += Vq * N * gn; // the water's exchange term, here so that the pair sums to zero
+				});
 			});
 		}
 		// the boundary terms of drained faces with p̄ ≠ 0 (eq. 2.2): −∮ N n p̄ n̂ on the water, the

@@ -58,7 +58,6 @@ struct PressureSystem {
 	std::vector<std::vector<Real>> rowBuffers; // per extra thread
 	std::vector<Real>        nodalPressure;   // per grid node: p^{n+1}, 0 off the pressure nodes [Pa]
 	std::vector<Vec3>        mobility;        // per grid node and axis: λ of eq. 8.5 with the walls' holds [m³ kg⁻¹]
-	std::vector<std::vector<Vec3>> porosityGradient; // per water set and point: ∇n at t^n [m⁻¹]
 	std::vector<PressureForceNode>              forces;
 	std::vector<std::vector<PressureForceNode>> forceBuffers;
 	Eigen::SparseMatrix<Real, Eigen::RowMajor> matrix;
