@@ -34,7 +34,10 @@ def consolidation_coefficient(intrinsic_permeability, viscosity, young_modulus, 
 
 
 def undrained_pressure_ratio(young_modulus, poisson_ratio, porosity, water_bulk_modulus):
-    """p0/q = (Kw/n)/(E_oed + Kw/n) for a sudden load q under uniaxial strain."""
+    """p0/q = (Kw/n)/(E_oed + Kw/n) for a sudden load q under uniaxial strain (1 for incompressible
+    water, Kw = inf)."""
+    if np.isinf(water_bulk_modulus):
+        return 1.0
     stiffness = water_bulk_modulus / porosity
     return stiffness / (constrained_modulus(young_modulus, poisson_ratio) + stiffness)
 

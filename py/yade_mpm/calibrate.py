@@ -1,0 +1,46 @@
+"""From measured DEM macro-properties to the MPM materials, in code (issue 16): no hand-typed copies.
+
+    modulus = yade_mpm.dem.measure_oedometric_modulus(sample)
+    flow = yade_mpm.dem.measure_permeability(sample, viscosity=10.0)
+    soil, water = yade_mpm.calibrate.materials_from_dem(modulus, flow, grain_density=sample.grain_density)
+
+The elastic skeleton takes the oedometric modulus E_oed and the lateral stress ratio K0 of the same
+drained load step: ν = K0/(1 + K0) (uniaxial strain of an isotropic elastic solid) and
+E = E_oed (1 + ν)(1 − 2ν)/(1 − ν), so that the MPM column has E_oed and K0 of the assembly. The
+porosity is the assembly's. The water is PFV's fluid: its viscosity μ, incompressible
+(bulkModulus = inf, as FlowEngine's default), and the intrinsic permeability κ = (k/μ) μ, so that
+c_v = (k/μ) E_oed is the same in both models.
+"""
+import math
+
+from yade.wrapper import MpmSoilMat, MpmWaterMat
+
+from . import analytical
+
+
+def elastic_constants(oedometric_modulus, lateral_ratio):
+    """(E, ν) of the isotropic elastic solid with constrained modulus E_oed [Pa] and K0 [-]."""
+    if not (math.isfinite(oedometric_modulus) and oedometric_modulus > 0):
+        raise ValueError("oedometric_modulus = %r Pa is outside the valid range (0, inf)" % (oedometric_modulus,))
+    if not (0 < lateral_ratio < 1):
+        raise ValueError("lateral_ratio = %r is outside the valid range (0, 1) of an elastic K0 (ν in (0, 0.5))" % (lateral_ratio,))
+    nu = lateral_ratio / (1 + lateral_ratio)
+    young = oedometric_modulus * (1 + nu) * (1 - 2 * nu) / (1 - nu)
+    return young, nu
+
+
+def materials_from_dem(modulus, flow, grain_density, water_density=1000.0, label="calibrated"):
+    """MpmSoilMat and MpmWaterMat from the dicts of dem.measure_oedometric_modulus (E_oed, K0,
+    porosity) and dem.measure_permeability (k/μ, μ)."""
+    young, nu = elastic_constants(modulus["oedometric_modulus"], modulus["lateral_ratio"])
+    viscosity = flow["viscosity"]
+    soil = MpmSoilMat(label=label + " soil", density=grain_density, youngModulus=young, poissonRatio=nu, porosity=modulus["porosity"],
+                      intrinsicPermeability=flow["k_over_mu"] * viscosity)
+    water = MpmWaterMat(label=label + " water", density=water_density, bulkModulus=float("inf"), viscosity=viscosity)
+    assert abs(analytical.constrained_modulus(young, nu) / modulus["oedometric_modulus"] - 1) < 1e-12
+    return soil, water
+
+
+def consolidation_coefficient(modulus, flow):
+    """c_v = (k/μ) E_oed [m² s⁻¹] of the assembly (incompressible grains and fluid)."""
+    return flow["k_over_mu"] * modulus["oedometric_modulus"]
