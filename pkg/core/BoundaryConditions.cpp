@@ -30,6 +30,25 @@ void BoundaryConditions::requireFreePeriodicFaces() const
 	}
 }
 
+int BoundaryConditions::plateFace() const
+{
+	for (int f = 0; f < faceCount; ++f)
+		if (walls[f].solid == SolidWall::Plate) return f;
+	return -1;
+}
+
+void BoundaryConditions::requireValidPlate() const
+{
+	int plates = 0;
+	for (int f = 0; f < faceCount; ++f) {
+		if (walls[f].solid != SolidWall::Plate) continue;
+		++plates;
+		if (walls[f].water != WaterWall::Impermeable)
+			throw InvalidParameter(std::string("the plate on face ") + faceName(f) + " needs an impermeable water wall there (a rigid plate keeps the water in)");
+	}
+	if (plates > 1) throw InvalidParameter("only one face may carry a plate (" + std::to_string(plates) + " do)");
+}
+
 NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& bcs, int i, int j, int k)
 {
 	NodeConstraint  c;
@@ -45,6 +64,10 @@ NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& 
 				c.solid     = { true, true, true };
 				onFixedWall = true;
 			} else if (wall.solid == SolidWall::Slip) c.solid[axis] = true;
+			else if (wall.solid == SolidWall::Plate) {
+				c.solid[axis] = c.water[axis] = true; // both phases take the plate's velocity along the axis
+				c.plateAxis                   = axis;
+			}
 			else if (wall.solid == SolidWall::Frictional) {
 				c.solid[axis]    = true;
 				c.friction[axis] = wall.friction;

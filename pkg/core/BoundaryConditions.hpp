@@ -18,6 +18,8 @@ enum class SolidWall {
 	Slip,  // smooth (roller) wall: normal solid velocity 0
 	Fixed, // rough rigid wall: all solid velocity components 0
 	Frictional, // contact: pushes (never pulls) the grains, tangential sliding resisted by Coulomb friction μ N' (theory.md eq. 2.6)
+	Plate,      // rigid, smooth, impermeable loading plate (theory.md eq. 2.9): one normal velocity for both phases at all its
+	            // nodes, moved by the face traction and the soil's reaction; at most one per domain, its water wall impermeable
 };
 
 enum class WaterWall {
@@ -69,6 +71,10 @@ struct BoundaryConditions {
 	// Throws InvalidParameter naming the face and the condition if a face of a periodic axis
 	// carries any wall condition (it would be silently ignored).
 	void requireFreePeriodicFaces() const;
+	// Throws InvalidParameter unless there is at most one Plate wall and its water wall is impermeable.
+	void requireValidPlate() const;
+	// The face of the Plate wall, −1 if none.
+	int plateFace() const;
 };
 
 // Which velocity components are held at zero at one node, per phase.
@@ -79,6 +85,7 @@ struct NodeConstraint {
 	// its inward normal (+1 on a lower wall, −1 on an upper one)
 	std::array<Real, 3> friction { 0, 0, 0 };
 	std::array<int, 3>  inward { 0, 0, 0 };
+	int                 plateAxis = -1; // the axis of a Plate wall this node moves with (both phases held along it), −1: none
 	bool                any() const { return solid[0] || solid[1] || solid[2] || water[0] || water[1] || water[2]; }
 	bool                contact() const { return inward[0] != 0 || inward[1] != 0 || inward[2] != 0; }
 };

@@ -50,6 +50,7 @@ ConstrainedNodes ConstrainedNodes::build(const GridGeometry& grid, const Boundar
 				const NodeConstraint c = constraintAt(grid, bcs, i, j, k);
 				if (!c.any()) continue;
 				if (c.contact()) out.contact.push_back(out.node.size());
+				if (c.plateAxis >= 0) out.plate.push_back(out.node.size());
 				out.node.push_back(grid.index(i, j, k));
 				out.constraint.push_back(c);
 			}
@@ -147,6 +148,37 @@ namespace stages {
 				else vsNew[d] = vs + (dt * fm[d] - mw * (vwNew[d] - vw)) / ms;
 			}
 			if (friction && hasS) applyCoulombFriction(nc, active.solid, normalForce, dt / s.mass, vsNew);
+		}
+	}
+
+	void moveRigidPlate(GridFields& fields, const ConstrainedNodes& constrained, Real dt, Real solidMassTolerance, Real waterMassTolerance,
+	                    PlateMotion& plate)
+	{
+		plate.mass = 0;
+		Real momentum = 0;
+		if (constrained.plate.empty()) return;
+		plate.axis  = constrained.constraint[constrained.plate.front()].plateAxis;
+		const int d = plate.axis;
+		for (std::size_t c : constrained.plate) {
+			const std::size_t i = constrained.node[c];
+			const SolidNode&  s = fields.solid[i];
+			const WaterNode&  w = fields.water[i];
+			const Real        ms = s.mass > solidMassTolerance ? s.mass : 0, mw = w.mass > waterMassTolerance ? w.mass : 0;
+			if (ms == 0 && mw == 0) continue;
+			plate.mass += ms + mw;
+			momentum += ms * fields.solidVelocity[i][d] + mw * fields.waterVelocity[i][d] + dt * (s.mixtureForce[d] + w.pressureForce[d] + w.weight[d]);
+		}
+		plate.velocity = plate.mass > 0 ? momentum / plate.mass : 0;
+		setPlateVelocity(fields, constrained, solidMassTolerance, waterMassTolerance, plate);
+	}
+
+	void setPlateVelocity(GridFields& fields, const ConstrainedNodes& constrained, Real solidMassTolerance, Real waterMassTolerance,
+	                      const PlateMotion& plate)
+	{
+		for (std::size_t c : constrained.plate) {
+			const std::size_t i = constrained.node[c];
+			if (fields.solid[i].mass > solidMassTolerance) fields.solidVelocityNew[i][plate.axis] = plate.velocity;
+			if (fields.water[i].mass > waterMassTolerance) fields.waterVelocityNew[i][plate.axis] = plate.velocity;
 		}
 	}
 

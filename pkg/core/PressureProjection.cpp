@@ -210,6 +210,37 @@ namespace stages {
 		}
 	}
 
+	template <class Kernel>
+	void assemblePlateCoupling(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, const std::vector<WaterPointSet*>& sets,
+	                           const ConstrainedNodes& constrained, const PlateMotion& plate, Real dt, PressureSystem& system)
+	{
+		system.plateCoupling.assign(system.node.size(), 0);
+		system.plateScale = plate.mass > 0 ? dt / plate.mass : 0;
+		std::vector<char> onPlate(grid.nodeCount(), 0);
+		for (std::size_t c : constrained.plate) onPlate[constrained.node[c]] = 1;
+		const int axis = plate.axis;
+		// each point adds V share D S_J, share = n (water) or 1 − n (solid), D = Σ_plate ∂_axis S_I
+		auto add = [&](const Vec3& x, const Vec3& halfLength, Real volume, bool water) {
+			Weights1D w[3];
+			weightsAt<Kernel>(grid, x, halfLength, w);
+			Real D = 0, n = 0;
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+				n += N * fields.porosity[I];
+				if (onPlate[I]) D += dN[axis];
+			});
+			if (D == 0) return;
+			n                 = std::clamp<Real>(n, 1e-5, 1);
+			const Real factor = volume * (water ? n : 1 - n) * D;
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+				if (system.row[I] >= 0) system.plateCoupling[static_cast<std::size_t>(system.row[I])] += factor * N;
+			});
+		};
+		for (const WaterPointSet* set : sets)
+			for (std::size_t p = 0; p < set->size(); ++p) add(set->position[p], set->halfLength[p], set->volume[p], true);
+		for (const SolidSet& set : solids)
+			for (std::size_t p = 0; p < set.points->size(); ++p) add(set.points->position[p], set.points->halfLength[p], set.points->volume[p], false);
+	}
+
 	void buildPressureMatrix(const GridGeometry& grid, PressureSystem& system)
 	{
 		const std::size_t active = system.node.size();
@@ -287,6 +318,9 @@ namespace stages {
 		system.meanDiagonal = n > 0 ? diagonalSum / n : 0;
 	}
 
+	// Relative residual of the plate's response K⁻¹b (eq. 2.9) in the Sherman–Morrison solve.
+	constexpr Real plateResponseTolerance = 1e-10;
+
 	PressureSolveReport solvePressure(PressureSystem& system, Real tolerance)
 	{
 		PressureSolveReport report;
@@ -305,6 +339,19 @@ namespace stages {
 			const int r = system.row[system.previousNode[e]];
 			if (r >= 0 && !system.fixed[r]) system.solution[system.unknown[r]] = system.previousSolution[e];
 		}
+		// the rigid plate (eq. 2.9): K + c b bᵀ by Sherman–Morrison, K⁻¹ r − K⁻¹b (c b·K⁻¹r)/(1 + c b·K⁻¹b),
+		// with the prescribed nodes' share of b·p moved to the right-hand side
+		const bool                         plate = !system.plateCoupling.empty() && system.plateScale > 0;
+		Eigen::Matrix<Real, Eigen::Dynamic, 1> coupling;
+		Real                                   fixedShare = 0;
+		if (plate) {
+			coupling.setZero(n);
+			for (std::size_t r = 0; r < active; ++r) {
+				if (system.fixed[r]) fixedShare += system.plateCoupling[r] * system.fixedValue[r];
+				else coupling[system.unknown[r]] = system.plateCoupling[r];
+			}
+			system.rhs -= system.plateScale * fixedShare * coupling;
+		}
 		const Real rhsNorm = system.rhs.norm();
 		if (rhsNorm > 0) {
 			Eigen::ConjugateGradient<Eigen::SparseMatrix<Real, Eigen::RowMajor>, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<Real>> cg;
@@ -314,7 +361,18 @@ namespace stages {
 			system.solution  = cg.solveWithGuess(system.rhs, system.solution);
 			report.iterations = cg.iterations();
 			report.residual   = cg.error() * rhsNorm / typical;
-			if (cg.info() != Eigen::Success || !system.solution.allFinite()) {
+			bool converged    = cg.info() == Eigen::Success;
+			if (plate && converged && coupling.norm() > 0) {
+				// K⁻¹b multiplies a pressure-sized factor: it needs the relative accuracy of the pressure
+				// itself, not that of r (which is small in a slow consolidation)
+				cg.setTolerance(plateResponseTolerance);
+				const Eigen::Matrix<Real, Eigen::Dynamic, 1> response = cg.solve(coupling); // K⁻¹ b
+				converged = converged && cg.info() == Eigen::Success;
+				report.iterations += cg.iterations();
+				const Real c = system.plateScale;
+				system.solution -= response * (c * coupling.dot(system.solution) / (1 + c * coupling.dot(response)));
+			}
+			if (!converged || !system.solution.allFinite()) {
 				std::ostringstream msg;
 				msg << "the pore-pressure solve did not converge: " << report.iterations << " conjugate-gradient iterations on " << n
 				    << " pressure nodes left a residual of " << report.residual << " Pa against pressureTolerance = " << tolerance
@@ -324,6 +382,7 @@ namespace stages {
 		} else {
 			system.solution.setZero(n);
 		}
+		if (plate) system.plateForce = coupling.dot(system.solution) + fixedShare;
 		system.previousNode.clear();
 		system.previousSolution.resize(n);
 		for (std::size_t r = 0; r < active; ++r) {
@@ -435,6 +494,8 @@ namespace stages {
 	template void assemblePressureSystem<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, const std::vector<WaterPointSet*>&, \
 	                                        const WaterParameters&, const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,  \
 	                                        PressureSystem&);                                                                                     \
+	template void assemblePlateCoupling<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, const std::vector<WaterPointSet*>&, \
+	                                       const ConstrainedNodes&, const PlateMotion&, Real, PressureSystem&);                           \
 	template void correctVelocities<K>(const GridGeometry&, GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&,         \
 	                                   const BoundaryConditions&,                                                                             \
 	                                   const Vec3&, Real, const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,  \

@@ -64,6 +64,11 @@ struct PressureSystem {
 	Eigen::Matrix<Real, Eigen::Dynamic, 1>     rhs, solution, previousSolution;
 	std::vector<std::size_t>                   previousNode; // grid node of each entry of previousSolution (warm start)
 	Real                                       meanDiagonal = 0; // mean K_JJ of the free rows [m³ s⁻¹ Pa⁻¹]
+	// The rigid plate (eq. 2.9): b_J = ∂(Bᵀv)_J/∂V per pressure node (empty: no plate) [m²], the
+	// scale c = Δt/M of the rank-one term c b bᵀ it adds to K [s kg⁻¹], and b·p^{n+1} after the solve,
+	// the pore pressure's total force on the plate's nodes along its axis [N].
+	std::vector<Real> plateCoupling;
+	Real              plateScale = 0, plateForce = 0;
 };
 
 namespace stages {
@@ -92,6 +97,12 @@ namespace stages {
 	void assemblePressureSystem(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, const std::vector<WaterPointSet*>& sets,
 	                            const WaterParameters& water, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
 	                            Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system);
+
+	// The rigid plate's column of B (theory.md eq. 2.9): b_J = Σ_wp V n D S_J + Σ_sp V (1 − n) D S_J with
+	// D = Σ_{I ∈ plate} ∂S_I/∂x_axis at the point, and c = Δt/M; K of eq. 8.7 gains c b bᵀ.
+	template <class Kernel>
+	void assemblePlateCoupling(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, const std::vector<WaterPointSet*>& sets,
+	                           const ConstrainedNodes& constrained, const PlateMotion& plate, Real dt, PressureSystem& system);
 
 	// The free rows of eq. 8.7 as a sparse (CSR) matrix and right-hand side, the prescribed
 	// pressures moved to the right-hand side: what a linear solver needs, nothing of the grid.

@@ -70,7 +70,16 @@ struct ConstrainedNodes {
 	std::vector<std::size_t>    node;
 	std::vector<NodeConstraint> constraint;
 	std::vector<std::size_t>    contact; // positions in node/constraint of nodes on a frictional (contact) wall
+	std::vector<std::size_t>    plate;   // positions in node/constraint of the nodes that move with the Plate wall
 	static ConstrainedNodes     build(const GridGeometry& grid, const BoundaryConditions& bcs);
+};
+
+// The rigid plate (theory.md eq. 2.9): its axis, the mass that moves with it (both phases at its
+// nodes) and its velocity along the axis, predicted (V*) then corrected by the pressure.
+struct PlateMotion {
+	int  axis     = -1; // −1: no plate
+	Real mass     = 0;  // M = Σ_plate (m^s + m^w) [kg]
+	Real velocity = 0;  // V [m s⁻¹]
 };
 
 namespace stages {
@@ -113,6 +122,15 @@ namespace stages {
 	void integrateNodalMomentum(GridFields& fields, const ConstrainedNodes& constrained, Real dt, DragScheme drag,
 	                            Real solidMassTolerance, Real waterMassTolerance, const std::vector<char>* suctionHolding = nullptr,
 	                            bool friction = true, std::vector<std::array<bool, 3>>* heldSolid = nullptr);
+
+	// The rigid plate (theory.md eq. 2.9), after integrateNodalMomentum: V from the momentum of
+	// both phases at its nodes and every force on them, V = Σ (m^s v^s + m^w v^w + Δt f^m)·e / M, set
+	// on both phases along its axis.
+	void moveRigidPlate(GridFields& fields, const ConstrainedNodes& constrained, Real dt, Real solidMassTolerance, Real waterMassTolerance,
+	                    PlateMotion& plate);
+	// Set both phases' velocity along the plate's axis to plate.velocity at its nodes.
+	void setPlateVelocity(GridFields& fields, const ConstrainedNodes& constrained, Real solidMassTolerance, Real waterMassTolerance,
+	                      const PlateMotion& plate);
 
 	// Coulomb friction of frictional walls (theory.md eq. 2.6) on the current new solid velocity,
 	// at the contact nodes whose normal `heldSolid` (from integrateNodalMomentum) holds.

@@ -140,6 +140,10 @@ namespace stages {
 		contactVelocity.clear();
 		if (solidPhase)
 			for (std::size_t c : constrained.contact) contactVelocity.push_back(remapped[constrained.node[c]]);
+		// The rigid plate's nodes keep its velocity along its axis (eq. 2.9), for both phases: held at 0
+		// there, the top cell would never feel the plate move
+		std::vector<Real> plateVelocity;
+		for (std::size_t c : constrained.plate) plateVelocity.push_back(remapped[constrained.node[c]][constrained.constraint[c].plateAxis]);
 		// Σ S m v and Σ S m with the weights at the moved points: dividing by the nodal mass of the
 		// step's start instead would make a uniformly moving body strain by ~ |v| Δt/h per step
 		std::vector<MomentumNode>& sums = workspace.remap;
@@ -163,6 +167,10 @@ namespace stages {
 		for (std::size_t c = 0; c < constrained.node.size(); ++c)
 			applyConstraint(solidPhase ? constrained.constraint[c].solid : constrained.constraint[c].water, remapped[constrained.node[c]]);
 		for (std::size_t f = 0; f < contactVelocity.size(); ++f) remapped[constrained.node[constrained.contact[f]]] = contactVelocity[f];
+		for (std::size_t f = 0; f < plateVelocity.size(); ++f) {
+			const std::size_t c = constrained.plate[f];
+			if (sums[constrained.node[c]].mass > massTolerance) remapped[constrained.node[c]][constrained.constraint[c].plateAxis] = plateVelocity[f];
+		}
 	}
 
 	template <class Kernel>

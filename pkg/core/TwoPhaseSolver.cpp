@@ -103,6 +103,7 @@ TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& setti
 {
 	settings_.validate();
 	domain_.boundaries.requireFreePeriodicFaces();
+	domain_.boundaries.requireValidPlate();
 	for (int f = 0; f < faceCount; ++f)
 		if (domain_.boundaries.walls[f].inflow && domain_.boundaries.walls[f].water != WaterWall::Drained)
 			throw InvalidParameter(std::string("the inflow face ") + faceName(f) + " must be a drained water wall");
@@ -300,6 +301,7 @@ void TwoPhaseSolver::integrateMomentum(Real dt, bool wet, bool semiImplicit)
 	// its time step knows no drag limit) and applies the wall friction once, after the corrector
 	integrateNodalMomentum(fields_, constrained_, dt, semiImplicit ? DragScheme::SemiImplicit : settings_.drag, solidMassTolerance_, waterMassTolerance_,
 	                       holdSuction ? &suctionHolding_ : nullptr, !semiImplicit, &heldSolid_);
+	if (!constrained_.plate.empty()) moveRigidPlate(fields_, constrained_, dt, solidMassTolerance_, waterMassTolerance_, plate_); // eq. 2.9
 }
 
 template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
@@ -311,6 +313,8 @@ template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
 		classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, pressureSystem_);
 		assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, water_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
 		                               pressureSystem_);
+		if (!constrained_.plate.empty()) assemblePlateCoupling<Kernel>(grid_, fields_, solids_, waters_, constrained_, plate_, dt, pressureSystem_);
+		else pressureSystem_.plateCoupling.clear();
 		buildPressureMatrix(grid_, pressureSystem_);
 	}
 	{
@@ -320,6 +324,10 @@ template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
 	StageTimer t(stageSeconds_, Stage::CorrectVelocities); // eq. 8.8, then the wall friction (eq. 2.6) once
 	correctVelocities<Kernel>(grid_, fields_, solids_, waters_, domain_.boundaries, g, water_.density, constrained_, heldSolid_, dt, solidMassTolerance_,
 	                          waterMassTolerance_, pressureSystem_);
+	if (!constrained_.plate.empty()) { // eq. 2.9: the plate moved by the pressure's force on it, as the solve assumed
+		plate_.velocity += pressureSystem_.plateScale * pressureSystem_.plateForce;
+		setPlateVelocity(fields_, constrained_, solidMassTolerance_, waterMassTolerance_, plate_);
+	}
 	applyWallFriction(fields_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_);
 }
 

@@ -139,6 +139,7 @@ private:
 	GridGeometry                  grid_;
 	GridFields                    fields_;
 	ConstrainedNodes              constrained_;
+	PlateMotion                   plate_; // the rigid plate's motion this step (eq. 2.9), when there is one
 	ScatterWorkspace              workspace_;
 	std::vector<Mat3>             velocityGradients_;
 	std::vector<Real>             volumetricRate_, pressureRate_, waterDivergence_, cellSum_, cellVolume_;

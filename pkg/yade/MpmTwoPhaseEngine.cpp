@@ -24,10 +24,11 @@ namespace {
 		                                                { "cpGIMP", mpm::ShapeFunction::CpGimp } } };
 	const Options<mpm::TimeScheme, 2>    schemeOptions { { { "semi-implicit", mpm::TimeScheme::SemiImplicit }, { "explicit", mpm::TimeScheme::Explicit } } };
 	const Options<mpm::DragScheme, 2>    dragOptions { { { "semi-implicit", mpm::DragScheme::SemiImplicit }, { "explicit", mpm::DragScheme::Explicit } } };
-	const Options<mpm::SolidWall, 4>     solidWallOptions { { { "free", mpm::SolidWall::Free },
+	const Options<mpm::SolidWall, 5>     solidWallOptions { { { "free", mpm::SolidWall::Free },
 		                                                      { "slip", mpm::SolidWall::Slip },
 		                                                      { "fixed", mpm::SolidWall::Fixed },
-		                                                      { "frictional", mpm::SolidWall::Frictional } } };
+		                                                      { "frictional", mpm::SolidWall::Frictional },
+		                                                      { "plate", mpm::SolidWall::Plate } } };
 	const Options<mpm::WaterWall, 3>     waterWallOptions { { { "free", mpm::WaterWall::Free },
 		                                                      { "impermeable", mpm::WaterWall::Impermeable },
 		                                                      { "drained", mpm::WaterWall::Drained } } };
@@ -61,6 +62,7 @@ mpm::Domain MpmTwoPhaseEngine::domain() const
 		if (!std::isfinite(wall.drainedPressure)) mpm::throwOutOfRange("drainedPressure[" + face + "]", wall.drainedPressure, "Pa", "finite values");
 	}
 	domain_.boundaries.requireFreePeriodicFaces();
+	domain_.boundaries.requireValidPlate();
 	for (std::size_t i = 0; i < domain_.sinks.size(); ++i) {
 		const mpm::WaterSink& sink = domain_.sinks[i];
 		if (!(sink.lower.array() <= sink.upper.array()).all() || !sink.lower.allFinite() || !sink.upper.allFinite())
@@ -234,7 +236,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		valueAttr<E>("pressureModeDamping", [](E& e) -> auto& { return e.settings_.pressureModeDamping; }, "Explicit scheme only (default False; refused with scheme='semi-implicit', which needs no relaxation): pore-pressure modes the grid cannot see (cell and node checkerboards, which exert no nodal force and so are never drained) relax towards the nodal average at the rate c_v/h² at which seepage drains a one-cell perturbation (theory.md eq. 4.17b), and in wall, face and surface cells towards a local linear fit at a slower rate (eq. 4.17c); off, they can grow without bound in long runs [-]"),
 		valueAttr<E>("freeSurfaceThreshold", [](E& e) -> auto& { return e.settings_.freeSurfaceThreshold; }, "Free-surface detection β [-], 0 ≤ β < 1: water points whose filling Σ S V_water/V_full of their nodes is below β get p = 0 (0.75 keeps exactly the outer layer with 2 points per cell and axis); 0: off"),
 		valueAttr<E>("freeSurfaceHoldsSuction", [](E& e) -> auto& { return e.settings_.freeSurfaceHoldsSuction; }, "Explicit scheme only (refused with scheme='semi-implicit'). With a free surface (freeSurfaceThreshold > 0): the surface keeps suction (p < 0), as capillary menisci hold the water to the grains there (no relative flow at its nodes), and releases only positive pressure, p = min(p, 0): a seepage face that lets water out but draws none in. False: p = 0 on every free-surface point, as under ponded water [-]"),
-		optionListAttr<E>("solidWalls", 6, faces, faceItem, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].solid; }, solidWallOptions, "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0), 'fixed' or 'frictional' (a contact: pushes the grains, never pulls them, and resists sliding by Coulomb friction wallFriction × the effective normal force; a fixed wall wins on a shared edge)"),
+		optionListAttr<E>("solidWalls", 6, faces, faceItem, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].solid; }, solidWallOptions, "Solid condition per face (xMin, xMax, yMin, yMax, zMin, zMax) [-]: 'free', 'slip' (normal velocity 0), 'fixed' or 'frictional' (a contact: pushes the grains, never pulls them, and resists sliding by Coulomb friction wallFriction × the effective normal force; a fixed wall wins on a shared edge); 'plate' (one face at most, its waterWalls entry 'impermeable': a rigid smooth loading plate, both phases on the face move along its normal with one velocity, loaded by faceTraction; theory.md eq. 2.9)"),
 		optionListAttr<E>("waterWalls", 6, faces, faceItem, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].water; }, waterWallOptions, "Water condition per face [-]: 'free', 'impermeable' (normal water velocity 0) or 'drained' (pore pressure held at drainedPressure)"),
 		inPlace(listAttr<E>("drainedPressure", 6, faces, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].drainedPressure; }, "Uniform part of the pore pressure p̄ held on each 'drained' face [Pa]")),
 		inPlace(listAttr<E>("faceTraction", 6, faces, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].traction; }, "Traction t per face (xMin, xMax, yMin, yMax, zMin, zMax) on the mixture, e.g. (0, 0, -q) on zMax for a surface load q on a soil whose top lies on that face, integrated as a boundary traction ∮ N t dA over the face (theory.md eq. 2.8); components a solid wall holds go to the wall; changed values apply in place [Pa]")),

