@@ -1,6 +1,7 @@
 """MPM against DEM + pore fluid, side by side (issue 16):
 
     python3 -m yade_mpm.compare oedometer [--quick] [--out DIR]
+    python3 -m yade_mpm.compare tradeoffs [--quick] [--out DIR]
     yade-double -n -x examples/dem/compare.py oedometer [--quick] [--out DIR]
 
 The oedometer: a sphere assembly (yade_mpm.dem) is compacted, its oedometric modulus, lateral stress
@@ -42,8 +43,10 @@ def run_dem_oedometer(grains, viscosity=VISCOSITY, load=LOAD):
             "flow": flow, "consolidation_coefficient": cv, "record": record, "total_wall_time": time.time() - clock}
 
 
-def run_mpm_oedometer(dem_result, cells, load=LOAD):
-    """The calibrated MPM column in this process, recorded at the same time factors and depths."""
+def run_mpm_oedometer(dem_result, cells, load=LOAD, points_per_cell=2, shape_function="uGIMP", time_step_factor=0.5):
+    """The calibrated MPM column in this process, recorded at the same time factors and depths; the
+    knobs that change its cost: cells over the height, points per cell and axis, the shape
+    functions and the factor on the critical step."""
     import yade_mpm
     from yade import O
     from . import analytical, builders, calibrate
@@ -52,17 +55,19 @@ def run_mpm_oedometer(dem_result, cells, load=LOAD):
     soil, water = calibrate.materials_from_dem(dem_result["modulus"], dem_result["flow"], dem_result["grain_density"])
     O.materials.append([soil, water])
     cell = height / cells
-    solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (cell, cell, height), cell, soil, water, points_per_cell=2, geostatic=False)
+    solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (cell, cell, height), cell, soil, water, points_per_cell=points_per_cell,
+                                                      geostatic=False)
     O.bodies.append([solid_body, water_body])
     p0 = builders.sudden_uniaxial_load(solid_body, water_body, soil, water, load)
     engine = yade_mpm.MpmTwoPhaseEngine(domainMin=(0, 0, 0), domainMax=(cell, cell, height), cellSize=cell,
                                         solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("drained",),
-                                        faceTraction=[(0, 0, 0)] * 5 + [(0, 0, -load)])
+                                        faceTraction=[(0, 0, 0)] * 5 + [(0, 0, -load)], shapeFunction=shape_function,
+                                        timeStepFactor=time_step_factor)
     O.engines = [engine]
     cv = analytical.consolidation_coefficient(soil.intrinsicPermeability, water.viscosity, soil.youngModulus, soil.poissonRatio, soil.porosity,
                                               water.bulkModulus)
     solid, fluid = solid_body.shape, water_body.shape
-    top = solid.pos[:, 2] > height - cell / 2
+    top = solid.pos[:, 2] > height - cell / points_per_cell  # the top layer of points
     start = solid.pos[top, 2].mean()
     record = {"time": [], "pressure": [], "settlement": [], "depths": DEPTHS, "load": load, "height": height}
     clock = time.time()
@@ -78,7 +83,8 @@ def run_mpm_oedometer(dem_result, cells, load=LOAD):
         record["settlement"].append(float(start - solid.pos[top, 2].mean()))
     record["wall_time"] = time.time() - clock
     record["steps"] = int(engine.solverSteps)
-    return {"cells": cells, "points": int(solid.count + fluid.count), "consolidation_coefficient": cv, "undrained_pressure": p0,
+    return {"cells": cells, "points_per_cell": points_per_cell, "shape_function": shape_function, "time_step_factor": time_step_factor,
+            "points": int(solid.count + fluid.count), "consolidation_coefficient": cv, "undrained_pressure": p0,
             "soil": {"youngModulus": soil.youngModulus, "poissonRatio": soil.poissonRatio, "porosity": soil.porosity,
                      "intrinsicPermeability": soil.intrinsicPermeability},
             "water": {"viscosity": water.viscosity, "bulkModulus": water.bulkModulus}, "record": record}
@@ -213,9 +219,108 @@ def _report(out_dir, dem_result, mpm_result, quick):
         f.write("\n".join(lines))
 
 
+# The speed-for-accuracy study (issue 16 item 4): each knob that changes the cost of a model, with
+# its error against Terzaghi and its wall time. The MPM runs on the material measured on the largest
+# assembly; one knob is varied at a time around 20 cells, 2 points per cell and axis, uGIMP, C = 0.5.
+DEM_GRAINS = [200, 300, 500, 1000]
+MPM_VARIANTS = ([("cells", dict(cells=c)) for c in (10, 20, 40, 80)] + [("points per cell", dict(cells=20, points_per_cell=k)) for k in (1, 3)]
+                + [("shape", dict(cells=20, shape_function=f)) for f in ("linear", "cpGIMP")]
+                + [("time-step factor", dict(cells=20, time_step_factor=c)) for c in (0.25, 1.0)])
+
+
+def _accuracy(result, oedometric_modulus):
+    errors = errors_against_terzaghi(result["record"], oedometric_modulus)
+    return max(errors["pressure"]), max(abs(u - e) for u, e in zip(errors["degree"], errors["degree_exact"]))
+
+
+def run_mpm_variants(dem_result, quick):
+    """Every MPM variant in this process; each returns its record and wall time."""
+    variants = MPM_VARIANTS[:3] + MPM_VARIANTS[4:] if quick else MPM_VARIANTS  # quick: no 80-cell column
+    return [dict(run_mpm_oedometer(dem_result, **knobs), knob=knob) for knob, knobs in variants]
+
+
+def tradeoffs(out_dir, quick):
+    """Run the study and write out_dir/tradeoffs.md with out_dir/figures/tradeoffs.png and .json."""
+    os.makedirs(os.path.join(out_dir, "figures"), exist_ok=True)
+    grains = DEM_GRAINS[:2] if quick else DEM_GRAINS
+    dem_results = []
+    for n in grains:
+        path = os.path.join(out_dir, "dem-%d.json" % n)
+        dem_results.append(_child(["_dem-oedometer", "--grains", str(n)], path))
+        os.remove(path)
+    reference = dem_results[-1]
+    reference_path, mpm_path = os.path.join(out_dir, "reference.json"), os.path.join(out_dir, "mpm.json")
+    with open(reference_path, "w") as f:
+        json.dump(reference, f)
+    variants = _child(["_mpm-variants", "--from-dem", reference_path] + (["--quick"] if quick else []), mpm_path)["variants"]
+    os.remove(reference_path)
+    os.remove(mpm_path)
+    rows = []
+    for result in dem_results:
+        pressure, degree = _accuracy(result, result["modulus"]["oedometric_modulus"])
+        record = result["record"]
+        rows.append({"method": "DEM + PFV", "knob": "grains", "setting": "%d grains" % result["grains"], "label": str(result["grains"]),
+                     "bodies": result["grains"],
+                     "steps": record["steps"], "wall_time": record["wall_time"], "per_simulated_second": record["wall_time"] / record["time"][-1],
+                     "pressure_error": pressure, "degree_error": degree, "peak_memory_MiB": result["peak_memory_MiB"]})
+    for result in variants:
+        pressure, degree = _accuracy(result, reference["modulus"]["oedometric_modulus"])
+        record = result["record"]
+        setting = "%d cells, %d ppc, %s, C = %g" % (result["cells"], result["points_per_cell"], result["shape_function"], result["time_step_factor"])
+        label = {"cells": "%d cells" % result["cells"], "points per cell": "%d ppc" % result["points_per_cell"], "shape": result["shape_function"],
+                 "time-step factor": "C = %g" % result["time_step_factor"]}[result["knob"]]
+        rows.append({"method": "MPM", "knob": result["knob"], "setting": setting, "label": label, "bodies": result["points"], "steps": record["steps"],
+                     "wall_time": record["wall_time"], "per_simulated_second": record["wall_time"] / record["time"][-1],
+                     "pressure_error": pressure, "degree_error": degree, "peak_memory_MiB": None})
+    with open(os.path.join(out_dir, "figures", "tradeoffs.json"), "w") as f:
+        json.dump({"quick": quick, "time_factors": TIME_FACTORS, "depths": DEPTHS, "rows": rows}, f, indent=1)
+    _tradeoff_figure(os.path.join(out_dir, "figures", "tradeoffs.png"), rows)
+    lines = ["# Speed for accuracy: the oedometer, DEM + PFV and MPM" + (" (quick)" if quick else ""), "",
+             "Written by `python3 -m yade_mpm.compare tradeoffs%s`: each model against Terzaghi's series at Tv = %s, probes at ζ = %s"
+             % (" --quick" if quick else "", ", ".join("%g" % t for t in TIME_FACTORS), ", ".join("%.1f" % z for z in DEPTHS)),
+             "(max |p − p_T|/q over them), and U from the settlement (max |U − U_T|). The MPM runs on the material measured on the %d-grain"
+             " assembly (c_v = %.4g m² s⁻¹) and varies one knob at a time around 20 cells over H, 2 points per cell and axis, uGIMP,"
+             " timeStepFactor C = 0.5. Wall times on the machine that ran it, one run each (the DEM runs with YADE's default single thread)."
+             % (reference["grains"], reference["consolidation_coefficient"]), "",
+             "| method | knob | setting | grains / points | steps | wall time of the consolidation [s] | wall s per simulated s | max \\|Δp\\|/q | max \\|ΔU\\| |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append("| %s | %s | %s | %d | %d | %.2f | %.3g | %.4f | %.4f |" % (r["method"], r["knob"], r["setting"], r["bodies"], r["steps"], r["wall_time"],
+                                                                          r["per_simulated_second"], r["pressure_error"], r["degree_error"]))
+    lines += ["", "![error against cost](figures/tradeoffs.png)", ""]
+    with open(os.path.join(out_dir, "tradeoffs.md"), "w") as f:
+        f.write("\n".join(lines))
+
+
+def _tradeoff_figure(path, rows):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4.6))
+    styles = {"grains": ("k", "o"), "cells": ("C0", "s"), "points per cell": ("C1", "^"), "shape": ("C2", "D"), "time-step factor": ("C3", "v")}
+    for knob, (colour, marker) in styles.items():
+        chosen = [r for r in rows if r["knob"] == knob]
+        if not chosen:
+            continue
+        name = "DEM + PFV: grains" if knob == "grains" else "MPM: " + knob
+        ax.loglog([r["per_simulated_second"] for r in chosen], [r["pressure_error"] for r in chosen], marker, color=colour, label=name,
+                  linestyle="-" if knob in ("grains", "cells") else "none")
+        for r in chosen:
+            ax.annotate(r["label"], (r["per_simulated_second"], r["pressure_error"]), fontsize=6, xytext=(3, 3), textcoords="offset points")
+    ax.set_xlabel("wall time per simulated second [s/s]")
+    ax.set_ylabel("max |p − p_Terzaghi| / q at the probes")
+    ax.set_title("oedometer: error against cost")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m yade_mpm.compare", description=__doc__.split("\n")[0])
-    parser.add_argument("case", choices=["oedometer", "_dem-oedometer", "_mpm-oedometer"], help="the scene to compare")
+    parser.add_argument("case", choices=["oedometer", "tradeoffs", "_dem-oedometer", "_mpm-oedometer", "_mpm-variants"],
+                        help="oedometer: both models side by side; tradeoffs: error against cost for each knob (doc/tradeoffs.md)")
+    parser.add_argument("--grains", type=int, help=argparse.SUPPRESS)
     parser.add_argument("--quick", action="store_true", help="300 grains and 20 cells over H (about a minute) instead of 1000 and 40")
     parser.add_argument("--out", default="compare-out", help="output directory (default: ./compare-out)")
     parser.add_argument("--json", help=argparse.SUPPRESS)
@@ -225,7 +330,17 @@ def main(argv=None):
     if args.case == "_dem-oedometer":
         import yade_mpm  # noqa: F401  (boots YADE)
         with open(args.json, "w") as f:
-            json.dump(run_dem_oedometer(grains), f)
+            json.dump(run_dem_oedometer(args.grains or grains), f)
+        return 0
+    if args.case == "_mpm-variants":
+        with open(args.from_dem) as f:
+            dem_result = json.load(f)
+        with open(args.json, "w") as f:
+            json.dump({"variants": run_mpm_variants(dem_result, args.quick)}, f)
+        return 0
+    if args.case == "tradeoffs":
+        tradeoffs(args.out, args.quick)
+        print("wrote %s (tradeoffs.md, figures/tradeoffs.png, figures/tradeoffs.json)" % args.out)
         return 0
     if args.case == "_mpm-oedometer":
         with open(args.from_dem) as f:
