@@ -3,13 +3,17 @@
     modulus = yade_mpm.dem.measure_oedometric_modulus(sample)
     flow = yade_mpm.dem.measure_permeability(sample, viscosity=10.0)
     soil, water = yade_mpm.calibrate.materials_from_dem(modulus, flow, grain_density=sample.grain_density)
+    for key, value in yade_mpm.calibrate.strength_from_triaxial(yade_mpm.dem.drained_triaxial()).items():
+        setattr(soil, key, value)  # Mohr–Coulomb strength from a drained triaxial test on the same grains
 
 The elastic skeleton takes the oedometric modulus E_oed and the lateral stress ratio K0 of the same
 drained load step: ν = K0/(1 + K0) (uniaxial strain of an isotropic elastic solid) and
 E = E_oed (1 + ν)(1 − 2ν)/(1 − ν), so that the MPM column has E_oed and K0 of the assembly. The
 porosity is the assembly's. The water is PFV's fluid: its viscosity μ, incompressible
 (bulkModulus = inf, as FlowEngine's default), and the intrinsic permeability κ = (k/μ) μ, so that
-c_v = (k/μ) E_oed is the same in both models.
+c_v = (k/μ) E_oed is the same in both models. The strength comes from a drained triaxial test on
+the same kind of assembly: the peak friction and dilatancy angles, and the friction angle at the end
+of the test as the residual one.
 """
 import math
 
@@ -44,3 +48,12 @@ def materials_from_dem(modulus, flow, grain_density, water_density=1000.0, label
 def consolidation_coefficient(modulus, flow):
     """c_v = (k/μ) E_oed [m² s⁻¹] of the assembly (incompressible grains and fluid)."""
     return flow["k_over_mu"] * modulus["oedometric_modulus"]
+
+
+def strength_from_triaxial(triaxial):
+    """Mohr–Coulomb strength of the MPM sand from dem.drained_triaxial: peak friction and dilatancy
+    angles, and the friction angle at the end of the test as the residual (critical-state) one,
+    as MpmSoilMat keyword arguments [rad] (theory.md §7)."""
+    peak, final = triaxial["peak_friction_angle"], triaxial["final_friction_angle"]
+    return {"model": "MohrCoulomb", "frictionAngle": peak, "residualFrictionAngle": min(final, peak),
+            "dilatancyAngle": max(0.0, min(triaxial["dilatancy_angle"], peak))}

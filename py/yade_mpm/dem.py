@@ -58,13 +58,10 @@ def _require(name, value, valid, text):
         raise ValueError("%s = %r is outside the valid range %s" % (name, value, text))
 
 
-def oedometer_sample(grains=300, width=1.0, stress=10e3, young=1e6, contact_poisson=0.5, friction_angle=math.radians(30),
-                     grain_density=2600.0, seed=1):
-    """Reset the scene and build a sphere assembly in a width³ box, compacted isotropically to
-    `stress` [Pa] by particle growth with low friction (3°, for a dense packing), then given its
-    contact `friction_angle` [rad] and brought to oedometric equilibrium under the vertical
-    `stress` with the top wall free along z. Returns an OedometerSample. `young` [Pa] and
-    `contact_poisson` [-] are the contact stiffness parameters of YADE's FrictMat."""
+def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle, grain_density, seed):
+    """Reset the scene; spheres in a width³ box of smooth walls compacted isotropically to `stress`
+    by particle growth with 3° contact friction (a dense packing), then given `friction_angle`.
+    Returns the wall ids and the TriaxialStressController (still in O.engines)."""
     _require("grains", grains, isinstance(grains, int) and grains >= 50, "[50, inf) (fewer grains cannot fill the box)")
     _require("width", width, width > 0, "(0, inf) m")
     _require("stress", stress, 0 < stress < young, "(0, young) Pa")
@@ -79,7 +76,7 @@ def oedometer_sample(grains=300, width=1.0, stress=10e3, young=1e6, contact_pois
     cloud = pack.SpherePack()
     cloud.makeCloud(lower, upper, -1, 0.3333, grains, False, 0.95, seed=seed)
     O.bodies.append([utils.sphere(center, radius, material="grains") for center, radius in cloud])
-    compaction = w.TriaxialStressController(maxMultiplier=1 + 2 * stress / young, finalMaxMultiplier=1 + 0.2 * stress / young, thickness=0,
+    controller = w.TriaxialStressController(maxMultiplier=1 + 2 * stress / young, finalMaxMultiplier=1 + 0.2 * stress / young, thickness=0,
                                             stressMask=7, internalCompaction=True, goal1=-stress, goal2=-stress, goal3=-stress)
     O.engines = [
         w.ForceResetter(),
@@ -88,16 +85,28 @@ def oedometer_sample(grains=300, width=1.0, stress=10e3, young=1e6, contact_pois
                           [w.Law2_ScGeom_FrictPhys_CundallStrack()]),
         w.FlowEngine(dead=True, label="flow"),
         w.GlobalStiffnessTimeStepper(active=True, timeStepUpdateInterval=100, timestepSafetyCoefficient=0.8),
-        compaction,
+        controller,
         w.NewtonIntegrator(damping=0.2),
     ]
     for _ in range(200):
         O.run(1000, True)
-        if utils.unbalancedForce() < 1e-3 and abs(compaction.meanStress + stress) < 1e-3 * stress:
+        if utils.unbalancedForce() < 1e-3 and abs(controller.meanStress + stress) < 1e-3 * stress:
             break
     else:
-        raise RuntimeError("oedometer_sample: the compaction to %g Pa did not reach equilibrium in 200 000 steps" % stress)
+        raise RuntimeError("the compaction to %g Pa did not reach equilibrium in 200 000 steps" % stress)
     utils.setContactFriction(friction_angle)
+    return wall_ids, controller
+
+
+def oedometer_sample(grains=300, width=1.0, stress=10e3, young=1e6, contact_poisson=0.5, friction_angle=math.radians(30),
+                     grain_density=2600.0, seed=1):
+    """Reset the scene and build a sphere assembly in a width³ box, compacted isotropically to
+    `stress` [Pa] by particle growth with low friction (3°, for a dense packing), then given its
+    contact `friction_angle` [rad] and brought to oedometric equilibrium under the vertical
+    `stress` with the top wall free along z. Returns an OedometerSample. `young` [Pa] and
+    `contact_poisson` [-] are the contact stiffness parameters of YADE's FrictMat."""
+    from yade import utils
+    wall_ids, _ = _compacted_box(grains, width, stress, young, contact_poisson, friction_angle, grain_density, seed)
     # from here on the top wall carries the load as a force; the time step is the P-wave one
     O.engines = [e for e in O.engines if not isinstance(e, (w.TriaxialStressController, w.GlobalStiffnessTimeStepper))]
     O.dynDt = False
@@ -239,3 +248,51 @@ def consolidate(sample, load, viscosity, times, depths=(0.3, 0.5, 0.7, 0.9), tim
     record["steps"] = int(round((O.time - start) / time_step))
     flow.dead = True
     return record
+
+
+def drained_triaxial(grains=300, confinement=10e3, friction_angle=math.radians(30), strain_rate=0.02, final_strain=0.15, width=1.0,
+                     young=1e6, contact_poisson=0.5, grain_density=2600.0, seed=1):
+    """A drained triaxial compression on the same kind of assembly: compacted isotropically to
+    `confinement` [Pa], then the top wall moves at the axial `strain_rate` [s⁻¹] (slow enough for
+    quasi-static shearing: an inertial number ε̇ d √(ρs/σ3) ≈ 1e-3 here) while the side walls hold σ3,
+    to the axial strain `final_strain`. Returns the curves (axial and volumetric strain,
+    compression-positive; σ1, σ3 [Pa]), the peak friction angle φ = asin((σ1 − σ3)/(σ1 + σ3)) at
+    the peak of the stress ratio (a moving mean over ±1000 steps), the friction angle over the last 10%
+    of the run (towards the critical state), and the mean dilatancy angle from the densest state to the
+    peak, sin ψ = −Δεv/(2Δε1 − Δεv) (compression-positive strains)."""
+    from yade import utils
+    _require("strain_rate", strain_rate, 0 < strain_rate <= 0.1, "(0, 0.1] s⁻¹ (faster is no longer quasi-static)")
+    _require("final_strain", final_strain, 0 < final_strain < 0.5, "(0, 0.5)")
+    wall_ids, controller = _compacted_box(grains, width, confinement, young, contact_poisson, friction_angle, grain_density, seed)
+    controller.internalCompaction = False
+    for _ in range(40):  # back to isotropic equilibrium with the final friction, walls servo-controlled
+        O.run(500, True)
+        if utils.unbalancedForce() < 1e-3 and abs(controller.meanStress + confinement) < 1e-3 * confinement:
+            break
+    controller.stressMask = 3  # x and y walls hold σ3; z follows the strain rate
+    controller.goal1 = controller.goal2 = -confinement
+    controller.goal3 = -strain_rate
+    axial0, volumetric0 = controller.strain[2], controller.volumetricStrain
+    curves = {"axial_strain": [], "volumetric_strain": [], "sigma1": [], "sigma3": []}
+    while True:
+        O.run(200, True)
+        axial = -(controller.strain[2] - axial0)
+        curves["axial_strain"].append(axial)
+        curves["volumetric_strain"].append(-(controller.volumetricStrain - volumetric0))
+        curves["sigma1"].append(-controller.stress(controller.wall_front_id)[2])
+        curves["sigma3"].append(-0.5 * (controller.stress(controller.wall_right_id)[0] + controller.stress(controller.wall_top_id)[1]))
+        if axial >= final_strain:
+            break
+    e1, ev = curves["axial_strain"], curves["volumetric_strain"]
+    raw = [(s1 - s3) / (s1 + s3) for s1, s3 in zip(curves["sigma1"], curves["sigma3"])]
+    # the stress ratio of a few hundred grains fluctuates as contacts slip: a moving mean over ±1000 steps
+    ratio = [sum(raw[max(0, i - 5):i + 6]) / len(raw[max(0, i - 5):i + 6]) for i in range(len(raw))]
+    peak = max(range(len(ratio)), key=ratio.__getitem__)
+    last = [r for e, r in zip(e1, raw) if e >= 0.9 * final_strain]
+    # mean dilatancy from the densest state (the end of contraction) to the peak
+    densest = max(range(peak + 1), key=ev.__getitem__)
+    lo, hi = (densest, peak) if peak - densest >= 5 else (max(0, peak - 10), min(len(e1) - 1, peak + 10))
+    slope = (ev[hi] - ev[lo]) / (e1[hi] - e1[lo])
+    return dict(curves, grains=grains, confinement=confinement, contact_friction_angle=friction_angle,
+                peak_friction_angle=math.asin(ratio[peak]), peak_axial_strain=e1[peak],
+                final_friction_angle=math.asin(sum(last) / len(last)), dilatancy_angle=math.asin(-slope / (2 - slope)))
