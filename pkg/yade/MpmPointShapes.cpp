@@ -25,7 +25,8 @@ namespace {
 			pointArrayAttr("mass", points, &mpm::MaterialPointSet::mass, massDoc.c_str()),
 			pointArrayAttr("volume", points, &mpm::MaterialPointSet::volume, "Current mixture volume represented by each point, shape (N,) [m³]"),
 			pointArrayAttr("halfLength", points, &mpm::MaterialPointSet::halfLength, "GIMP half-lengths of each point's domain l_p, shape (N, 3) [m]"),
-			readOnly(AttrSpec<Owner> { "count", "Number of points N [-]", [points](const Owner& o) { return py::object((o.*points).size()); }, nullptr }),
+			readOnly(AttrSpec<Owner> { "count", "Number of points N [-]", [points](const Owner& o) { return py::object((o.*points).size()); }, nullptr,
+			                           {}, false }), // derived from the arrays: not saved
 		};
 	}
 
