@@ -110,6 +110,10 @@ def test_python_and_cpp_analytical_solutions_agree():
     assert analytical.terzaghi_pressure_ratio(1.0, 0.5) == pytest.approx(0.3708, abs=1e-4)
     assert analytical.terzaghi_degree(0.2) == pytest.approx(0.5041, abs=1e-4)
     assert analytical.terzaghi_degree(1.0) == pytest.approx(0.9313, abs=1e-4)
+    # Mandel (ν = 0.3): the roots and centre values of tests/benchmarks/test_mandel.cpp
+    assert analytical.mandel_roots(0.3, 2) == pytest.approx([1.36437, 4.65104], abs=1e-5)
+    assert analytical.mandel_pressure_ratio(0.0, 0.05, 0.3) == pytest.approx(1.073, abs=1e-3)
+    assert analytical.mandel_pressure_ratio(0.0, 1.0, 0.3) == pytest.approx(0.208, abs=1e-3)
 
 
 def test_points_leaving_the_grid_stop_the_run_with_a_clear_message():
