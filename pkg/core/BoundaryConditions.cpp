@@ -30,13 +30,6 @@ void BoundaryConditions::requireFreePeriodicFaces() const
 	}
 }
 
-int BoundaryConditions::plateFace() const
-{
-	for (int f = 0; f < faceCount; ++f)
-		if (walls[f].solid == SolidWall::Plate) return f;
-	return -1;
-}
-
 void BoundaryConditions::requireValidPlate() const
 {
 	int plates = 0;

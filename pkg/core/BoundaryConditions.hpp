@@ -73,8 +73,6 @@ struct BoundaryConditions {
 	void requireFreePeriodicFaces() const;
 	// Throws InvalidParameter unless there is at most one Plate wall and its water wall is impermeable.
 	void requireValidPlate() const;
-	// The face of the Plate wall, −1 if none.
-	int plateFace() const;
 };
 
 // Which velocity components are held at zero at one node, per phase.

@@ -151,7 +151,7 @@ namespace stages {
 							lambda += Ni * system.mobility[I];
 							divW += fields.waterVelocityNew[I].dot(dN[c][b][a]);
 						}
-				n        = std::clamp<Real>(n, 1e-5, 1);
+				n        = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 				const Real V = P.volume[p];
 				// eq. 8.2, the water's share n∇·vw (the exchange term vw·∇n and the solid's share are
 				// added at the solid points below)
@@ -229,7 +229,7 @@ namespace stages {
 				if (onPlate[I]) D += dN[axis];
 			});
 			if (D == 0) return;
-			n                 = std::clamp<Real>(n, 1e-5, 1);
+			n                 = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 			const Real factor = volume * (water ? n : 1 - n) * D;
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 				if (system.row[I] >= 0) system.plateCoupling[static_cast<std::size_t>(system.row[I])] += factor * N;

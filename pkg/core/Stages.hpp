@@ -84,6 +84,10 @@ struct PlateMotion {
 
 namespace stages {
 
+	// Floor of the porosity interpolated at a point next to the soil's edge, where its nodes reach the
+	// soil only by a sliver of their weights: n stays positive, so n-weighted terms and 1/n stay finite.
+	constexpr Real minimumInterpolatedPorosity = 1e-5;
+
 	// Step 0: zero the nodal arrays (the water ones only when `water`: a dry scene leaves them zero).
 	void resetGrid(GridFields& fields, bool water = true);
 

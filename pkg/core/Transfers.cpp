@@ -98,7 +98,7 @@ namespace stages {
 					soil = soil || (N > 0 && nodalPorosity[I] < 1);
 				});
 				// free water is n = 1 exactly (the sum of the weights is 1 only to round-off)
-				n              = soil ? std::clamp<Real>(n, 1e-5, 1) : 1;
+				n              = soil ? std::clamp<Real>(n, minimumInterpolatedPorosity, 1) : 1;
 				P.porosity[p]  = n;
 				const Real m = P.mass[p], V = P.volume[p], pressure = pressureForces ? P.porePressure[p] : 0;
 				const Vec3 weight = m * gravity;

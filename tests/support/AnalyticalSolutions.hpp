@@ -37,6 +37,7 @@ inline double consolidationCoefficient(double mobility, double constrainedModulu
 // Undrained pore-pressure ratio p0/q = (Kw/n)/(E_oed + Kw/n).
 inline double undrainedPressureRatio(double constrainedModulus, double porosity, double waterBulkModulus)
 {
+	if (std::isinf(waterBulkModulus)) return 1; // incompressible water carries the whole load (inf/inf otherwise)
 	return (waterBulkModulus / porosity) / (constrainedModulus + waterBulkModulus / porosity);
 }
 
