@@ -124,6 +124,26 @@ namespace stages {
 				else if (waterHeld) system.mobility[I][d] = hasS ? sn.solidVolume / sn.mass : 0;                          // 1/ρs: the grains take the whole force
 			}
 		}
+		// the velocities the pressure forces act on (eqs. 8.1–8.2): the skeleton's share at the solid
+		// points acts on v^s where the skeleton has mass (else on v^w); the water points' share of the
+		// mixture's divergence form, less the water's own gradient force (the reaction on the grains),
+		// acts on the grains over the part θ = min(1, V_I/V^w_I) of the water-sampled support that the
+		// skeleton covers, on the water elsewhere: v^m = θ v^s + (1 − θ) v^w, relative w = θ (v^w − v^s)
+		system.skeletonShare.resize(nodes);
+		system.solidPointVelocity.resize(nodes);
+		system.mixtureVelocity.resize(nodes);
+		system.relativeVelocity.resize(nodes);
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
+		for (std::size_t I = 0; I < nodes; ++I) {
+			const bool hasS = fields.solid[I].mass > solidMassTolerance, hasW = fields.water[I].mass > waterMassTolerance;
+			const Real theta = !hasS ? 0 : !hasW ? 1 : std::min<Real>(1, fields.solid[I].volume / fields.water[I].volume);
+			const Vec3& vs = fields.solidVelocityNew[I];
+			const Vec3& vw = fields.waterVelocityNew[I];
+			system.skeletonShare[I]      = theta;
+			system.solidPointVelocity[I] = hasS ? vs : vw;
+			system.mixtureVelocity[I]    = theta * vs + (1 - theta) * vw;
+			system.relativeVelocity[I]   = theta * (vw - vs);
+		}
 		system.rows.assign(system.node.size() * PressureSystem::rowStride, 0);
 		const Real invKw = 1 / water.bulkModulus; // 0 for incompressible water (Kw = ∞)
 		for (std::size_t s = 0; s < sets.size(); ++s) {
@@ -133,10 +153,10 @@ namespace stages {
 				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
 				int node[3][S];
 				stencilNodes(grid, w, node);
-				// the porosity and mobility at the water point (eqs. 4.5, 8.5) and the divergence of the
-				// predicted water velocity
-				Real n = 0, divW = 0;
-				Vec3 lambda = Vec3::Zero();
+				// the porosity and mobility at the water point (eqs. 4.5, 8.5), the divergence of the
+				// predicted skeleton (mixture) velocity and the relative velocity w = vw − vs
+				Real n = 0, divMixture = 0;
+				Vec3 lambda = Vec3::Zero(), relative = Vec3::Zero();
 				Real N[S][S][S];
 				Vec3 dN[S][S][S];
 				for (int c = 0; c < S; ++c)
@@ -149,13 +169,16 @@ namespace stages {
 							const Real        Ni = N[c][b][a];
 							n += Ni * fields.porosity[I];
 							lambda += Ni * system.mobility[I];
-							divW += fields.waterVelocityNew[I].dot(dN[c][b][a]);
+							divMixture += system.mixtureVelocity[I].dot(dN[c][b][a]);
+							relative += Ni * system.relativeVelocity[I];
 						}
 				n        = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 				const Real V = P.volume[p];
-				// eq. 8.2, the water's share n∇·vw (the exchange term vw·∇n and the solid's share are
+				// eq. 8.2, the water point's share: n S_J ∇·vs − n w·∇S_J (the relative flux in weak
+				// form: its natural condition is no relative flow; the solid's share (1 − n) S_J ∇·vs is
 				// added at the solid points below)
-				const Real divergence = n * divW;
+				const Vec3 relativeFlux = n * relative;
+				const Real divergence   = n * divMixture;
 				const Real storage    = V * n * invKw / dt; // C/Δt (eq. 8.3), consistent: Σ V S_J S_K n/(Kw Δt)
 				const Vec3 conductance = dt * V * lambda;    // Δt L (eq. 8.6), per axis
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n
@@ -169,7 +192,7 @@ namespace stages {
 							const Real Nj = N[c][b][a];
 							if (Nj == 0 && dN[c][b][a].isZero()) continue;
 							Real* r = rows + static_cast<std::size_t>(system.row[grid.index(node[0][a], node[1][b], node[2][c])]) * PressureSystem::rowStride;
-							r[PressureSystem::rhsSlot] += Nj * (stored - V * divergence);
+							r[PressureSystem::rhsSlot] += Nj * (stored - V * divergence) + V * relativeFlux.dot(dN[c][b][a]);
 							const Real storageJ = storage * Nj;
 							const Vec3 gradJ    = dN[c][b][a];
 							for (int cc = 0; cc < S; ++cc)
@@ -189,20 +212,16 @@ namespace stages {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
 				Real n = 0, divS = 0;
-				Vec3 gradn = Vec3::Zero(), vs = Vec3::Zero(), vw = Vec3::Zero();
 				bool reaches = false;
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 					n += N * fields.porosity[I];
-					gradn += fields.porosity[I] * dN;
-					vs += N * fields.solidVelocityNew[I];
-					vw += N * fields.waterVelocityNew[I];
-					divS += fields.solidVelocityNew[I].dot(dN);
+					divS += system.solidPointVelocity[I].dot(dN);
 					reaches = reaches || system.row[I] >= 0;
 				});
 				if (!reaches) return;
-				// (1 − n)∇·vs + (vw − vs)·∇n: the exchange term of both phases where ∇n is, at the
-				// skeleton's points, so that the pressure forces it is adjoint to sum to zero
-				const Real source = P.volume[p] * ((1 - n) * divS + (vw - vs).dot(gradn));
+				// (1 − n) S_J ∇·vs: the skeleton's share of the mixture's volume change
+				n                 = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
+				const Real source = P.volume[p] * (1 - n) * divS;
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 					if (system.row[I] >= 0) rows[static_cast<std::size_t>(system.row[I]) * PressureSystem::rowStride + PressureSystem::rhsSlot] -= N * source;
 				});
@@ -396,55 +415,60 @@ namespace stages {
 	}
 
 	template <class Kernel>
-	void correctVelocities(const GridGeometry& grid, GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
-	                       const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, const ConstrainedNodes& constrained,
-	                       const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system)
+	void accumulatePressureForces(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                              const std::vector<Real>& pressure, bool storePointPressures, PressureSystem& system)
 	{
-		const std::vector<Real>& pressure = system.nodalPressure;
 		system.forces.assign(grid.nodeCount(), zeroOf(PressureForceNode {}));
 		for (std::size_t s = 0; s < sets.size(); ++s) {
 			WaterPointSet&           P     = *sets[s];
 			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
-				Real q = 0;
-				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) { q += N * pressure[I]; });
-				P.porePressure[p] = q; // S4a: p^{n+1} at the point, with the weights of t^n
-				const Real n = P.porosity[p], Vq = P.volume[p] * q;
-				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) {
-					nodes[I].water += Vq * n * dN; // eq. 8.1: n ∇S_I (the exchange S_I ∇n at the solid points)
+				Real q = 0, n = 0;
+				Vec3 gradq = Vec3::Zero();
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					q += N * pressure[I];
+					gradq += pressure[I] * dN;
+					n += N * fields.porosity[I];
+				});
+				if (storePointPressures) P.porePressure[p] = q; // S4a: p^{n+1} at the point, with the weights of t^n
+				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
+				const Real V = P.volume[p];
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+					// eq. 8.1: the water's force in gradient form, −n S_I ∇p (no surface term: nothing
+					// crosses a surface the water points sample only in part), and the water's share of
+					// the mixture's divergence form, n p ∇S_I, less that, on the skeleton
+					const Vec3 onWater  = -V * n * N * gradq;
+					const Vec3 reaction = V * n * q * dN - onWater;
+					const Real theta    = system.skeletonShare[I];
+					nodes[I].water += onWater + (1 - theta) * reaction;
+					nodes[I].solid += theta * reaction;
 				});
 			});
 		}
-		// g^s at the solid points, ∇((1 − n) S_I) (eq. 8.1): the adjoint of the solid's share above
+		// the skeleton's share of the mixture's divergence form, (1 − n) p ∇S_I, at the solid points
 		for (const SolidSet& set : solids) {
 			const SolidPointSet& P = *set.points;
 			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
 				Real q = 0, n = 0;
-				Vec3 gn = Vec3::Zero();
-				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 					q += N * pressure[I];
 					n += N * fields.porosity[I];
-					gn += fields.porosity[I] * dN;
 				});
-				const Real Vq = P.volume[p] * q;
-				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
-					nodes[I].solid += Vq * ((1 - n) * dN - N * gn);
-					nodes[I].water += Vq * N * gn; // the water's exchange term, here so that the pair sums to zero
-				});
+				n             = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
+				const Real Vq = P.volume[p] * q * (1 - n);
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) { nodes[I].solid += Vq * dN; });
 			});
 		}
-		// the boundary terms of drained faces with p̄ ≠ 0 (eq. 2.2): −∮ N n p̄ n̂ on the water, the
-		// rest of −∮ N p̄ n̂ on the solid. They belong with the pressure forces: in the predictor they
-		// would meet no pressure gradient and throw the face nodes' water far off before the solve.
-		forEachDrainedFaceTraction(grid, bcs, gravity, waterDensity, waterMassTolerance, fields, [&](std::size_t I, const Vec3& traction) {
-			system.forces[I].water += fields.porosity[I] * traction;
-			system.forces[I].solid += (1 - fields.porosity[I]) * traction;
-		});
-		// eq. 8.8: the nodal 2×2 drag system for the velocity increments
-		const std::size_t nodes = grid.nodeCount();
+	}
+
+	template <class F>
+	void forEachPressureIncrement(const GridFields& fields, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
+	                              Real solidMassTolerance, Real waterMassTolerance, const PressureSystem& system, F&& apply)
+	{
+		const std::size_t nodes = fields.solid.size();
 		auto increments = [&](std::size_t i, Vec3& ds, Vec3& dw) {
 			const SolidNode&         s = fields.solid[i];
 			const WaterNode&         wn = fields.water[i];
@@ -459,33 +483,87 @@ namespace stages {
 				ds = (dt / s.mass) * (g.solid + g.water); // the whole pressure force on the mixture
 			}
 		};
+		// `apply(i, ds, dw, mixture)`: mixture[d] where both forces act on one velocity (a node with one
+		// phase, or the water held along d with the skeleton free)
+		std::vector<int> constraintOf(nodes, -1);
+		for (std::size_t c = 0; c < constrained.node.size(); ++c) constraintOf[constrained.node[c]] = static_cast<int>(c);
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 		for (std::size_t i = 0; i < nodes; ++i) {
 			Vec3 ds, dw;
 			increments(i, ds, dw);
+			const bool           onePhase = !(fields.solid[i].mass > solidMassTolerance && fields.water[i].mass > waterMassTolerance);
+			std::array<bool, 3>  mixture { onePhase, onePhase, onePhase };
+			const int c = constraintOf[i];
+			if (c >= 0) {
+				// held components (theory.md §2): the same rules as in the predictor, for the increments
+				const NodeConstraint&    nc = constrained.constraint[c];
+				const SolidNode&         s  = fields.solid[i];
+				const WaterNode&         wn = fields.water[i];
+				const PressureForceNode& g  = system.forces[i];
+				const bool hasS = s.mass > solidMassTolerance, hasW = wn.mass > waterMassTolerance;
+				for (int d = 0; d < 3; ++d) {
+					const bool solidHeld = heldSolid[c][d], waterHeld = nc.water[d];
+					if (!solidHeld && !waterHeld) continue;
+					Real dsHeld = 0, dwHeld = 0;
+					if (solidHeld && !waterHeld && hasW) dwHeld = dt * g.water[d] / (wn.mass + (hasS ? s.drag * dt : 0)); // water dragged by the held solid
+					if (waterHeld && !solidHeld && hasS) dsHeld = dt * (g.solid[d] + g.water[d]) / s.mass;               // mixture momentum, water held
+					if (waterHeld && !solidHeld) mixture[d] = true;
+					ds[d] = dsHeld;
+					dw[d] = dwHeld;
+				}
+			}
+			apply(i, ds, dw, mixture);
+		}
+	}
+
+	template <class Kernel>
+	void correctVelocities(const GridGeometry& grid, GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                       const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, const ConstrainedNodes& constrained,
+	                       const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system)
+	{
+		accumulatePressureForces<Kernel>(grid, fields, solids, sets, system.nodalPressure, true, system);
+		// the boundary terms of drained faces with p̄ ≠ 0 (eq. 2.2), −∮ N p̄ n̂ dA. They belong with the
+		// pressure forces: in the predictor they would meet no pressure gradient and throw the face
+		// nodes' water far off before the solve. The water's own force is in gradient form and takes
+		// no surface term: the whole traction acts on the mixture's divergence form, i.e. on the
+		// skeleton's row (on the water's at a water-only node)
+		forEachDrainedFaceTraction(grid, bcs, gravity, waterDensity, waterMassTolerance, fields,
+		                           [&](std::size_t I, const Vec3& traction) { system.forces[I].solid += traction; });
+		// eq. 8.8: the nodal 2×2 drag system for the velocity increments
+		forEachPressureIncrement(fields, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, system,
+		                         [&](std::size_t i, const Vec3& ds, const Vec3& dw, const std::array<bool, 3>&) {
 			fields.solidVelocityNew[i] += ds;
 			fields.waterVelocityNew[i] += dw;
-		}
-		// held components (theory.md §2): the same rules as in the predictor, for the velocity increments
-		for (std::size_t c = 0; c < constrained.node.size(); ++c) {
-			const std::size_t        i  = constrained.node[c];
-			const NodeConstraint&    nc = constrained.constraint[c];
-			const SolidNode&         s  = fields.solid[i];
-			const WaterNode&         wn = fields.water[i];
-			const PressureForceNode& g  = system.forces[i];
-			const bool hasS = s.mass > solidMassTolerance, hasW = wn.mass > waterMassTolerance;
-			Vec3 ds, dw;
-			increments(i, ds, dw);
-			for (int d = 0; d < 3; ++d) {
-				const bool solidHeld = heldSolid[c][d], waterHeld = nc.water[d];
-				if (!solidHeld && !waterHeld) continue;
-				Real dsHeld = 0, dwHeld = 0;
-				if (solidHeld && !waterHeld && hasW) dwHeld = dt * g.water[d] / (wn.mass + (hasS ? s.drag * dt : 0)); // water dragged by the held solid
-				if (waterHeld && !solidHeld && hasS) dsHeld = dt * (g.solid[d] + g.water[d]) / s.mass;               // mixture momentum, water held
-				fields.solidVelocityNew[i][d] += dsHeld - ds[d];
-				fields.waterVelocityNew[i][d] += dwHeld - dw[d];
-			}
-		}
+		});
+	}
+
+	template <class Kernel>
+	ProjectionForms projectionForms(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                                const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
+	                                Real waterMassTolerance, const std::vector<Real>& freePressures, PressureSystem& system)
+	{
+		ProjectionForms forms;
+		const long      n = system.matrix.rows();
+		Eigen::Map<const Eigen::Matrix<Real, Eigen::Dynamic, 1>> q(freePressures.data(), n);
+		forms.compact = q.dot(system.matrix * q);
+		std::vector<Real> pressure(grid.nodeCount(), 0);
+		for (std::size_t r = 0; r < system.node.size(); ++r)
+			if (!system.fixed[r]) pressure[system.node[r]] = freePressures[static_cast<std::size_t>(system.unknown[r])];
+		accumulatePressureForces<Kernel>(grid, fields, solids, sets, pressure, false, system);
+		Real exact = 0;
+		forEachPressureIncrement(fields, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, system,
+		                         [&](std::size_t i, const Vec3& ds, const Vec3& dw, const std::array<bool, 3>& mixture) {
+			// the work of the forces on the velocities they give (both forces on one velocity where
+			// `mixture` says so)
+			const PressureForceNode& g    = system.forces[i];
+			Real                     work = 0;
+			for (int d = 0; d < 3; ++d)
+				work += mixture[d] ? (g.solid[d] + g.water[d]) * (ds[d] + dw[d]) : g.solid[d] * ds[d] + g.water[d] * dw[d];
+#pragma omp atomic
+			exact += work;
+		});
+		forms.exact = exact;
+		return forms;
 	}
 
 #define MPM_INSTANTIATE_PROJECTION(K)                                                                                                      \
@@ -499,7 +577,10 @@ namespace stages {
 	template void correctVelocities<K>(const GridGeometry&, GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&,         \
 	                                   const BoundaryConditions&,                                                                             \
 	                                   const Vec3&, Real, const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,  \
-	                                   PressureSystem&);
+	                                   PressureSystem&);                                                                                     \
+	template ProjectionForms projectionForms<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&, \
+	                                            const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,                \
+	                                            const std::vector<Real>&, PressureSystem&);
 
 	MPM_INSTANTIATE_PROJECTION(LinearKernel)
 	MPM_INSTANTIATE_PROJECTION(GimpKernel)

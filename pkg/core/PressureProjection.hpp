@@ -42,6 +42,12 @@ struct PressureSolveReport {
 	Real        residual   = 0; // ‖r‖₂ / mean K_JJ at the end: a pressure [Pa]
 };
 
+// Quadratic forms of the compact and the exact projection operators for one pressure field.
+struct ProjectionForms {
+	Real compact = 0; // pᵀ K p of eq. 8.7 [m³ s⁻¹ Pa⁻¹ Pa²]
+	Real exact   = 0; // Δt pᵀ BᵀM⁻¹B p (+ pᵀ C p/Δt is not included) [same]
+};
+
 // The grid-node system of eq. 8.7 and its scratch, reused from step to step.
 struct PressureSystem {
 	// One row of K in stencil form: offsets (−2..2)³ between two nodes that share a point, then b_J.
@@ -58,6 +64,10 @@ struct PressureSystem {
 	std::vector<std::vector<Real>> rowBuffers; // per extra thread
 	std::vector<Real>        nodalPressure;   // per grid node: p^{n+1}, 0 off the pressure nodes [Pa]
 	std::vector<Vec3>        mobility;        // per grid node and axis: λ of eq. 8.5 with the walls' holds [m³ kg⁻¹]
+	std::vector<Real>        skeletonShare;      // per grid node: θ = min(1, V_I/V^w_I), 1 without water, 0 without skeleton (eq. 8.1) [-]
+	std::vector<Vec3>        solidPointVelocity; // per grid node: v*^s where the skeleton has mass, else v*^w (eq. 8.2) [m s⁻¹]
+	std::vector<Vec3>        mixtureVelocity;    // per grid node: θ v*^s + (1 − θ) v*^w (eq. 8.2) [m s⁻¹]
+	std::vector<Vec3>        relativeVelocity;   // per grid node: θ (v*^w − v*^s) (eq. 8.2) [m s⁻¹]
 	std::vector<PressureForceNode>              forces;
 	std::vector<std::vector<PressureForceNode>> forceBuffers;
 	Eigen::SparseMatrix<Real, Eigen::RowMajor> matrix;
@@ -123,6 +133,15 @@ namespace stages {
 	void correctVelocities(const GridGeometry& grid, GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
 	                       const BoundaryConditions& bcs, const Vec3& gravity, Real waterDensity, const ConstrainedNodes& constrained,
 	                       const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system);
+
+	// The two quadratic forms of the projection for free nodal pressures p (theory.md §8.6): the
+	// compact pᵀ(Δt L + C/Δt)p of eq. 8.7 and the exact Δt pᵀ BᵀM⁻¹B p = Σ_I g_I · δ_I (the forces of
+	// p and the velocity increments they give, walls held). Stability of the stabilised projection
+	// needs compact ≥ exact (for C = 0). A check, run inside a step by TwoPhaseSolver.
+	template <class Kernel>
+	ProjectionForms projectionForms(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                                const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
+	                                Real waterMassTolerance, const std::vector<Real>& freePressures, PressureSystem& system);
 
 	// Velocity increments of one node for pressure forces g^s, g^w (eq. 8.8): the nodal 2×2 system
 	// [ms + QΔt, −QΔt; −QΔt, mw + QΔt] (δs, δw) = Δt (g^s, g^w), in closed form.

@@ -3,6 +3,8 @@
 // pointers to the point sets it owns and the validated parameters.
 #pragma once
 
+#include <functional>
+
 #include "PressureProjection.hpp"
 #include "Stages.hpp"
 
@@ -118,8 +120,14 @@ public:
 	const PressureSystem&                               pressureSystem() const { return pressureSystem_; } // the last step's (tests, diagnostics)
 	const GridFields&                                   fields() const { return fields_; }
 	const SolverSettings&                               settings() const { return settings_; }
+	// A check of the semi-implicit projection (theory.md §8.6, tests): runs the stages of a step of
+	// size dt up to the assembled system of eq. 8.7, without moving any point, and returns the
+	// compact and the exact quadratic forms for each of the given free nodal pressure fields (each
+	// sized to the free nodes; `fields(freeNodes)` builds them from the free nodes' positions).
+	std::vector<ProjectionForms> projectionForms(Real dt, const std::function<std::vector<std::vector<Real>>(const std::vector<Vec3>&)>& fields);
 
 private:
+	template <class Kernel> std::vector<ProjectionForms> projectionFormsWith(Real dt, const std::function<std::vector<std::vector<Real>>(const std::vector<Vec3>&)>& fields);
 	template <class Kernel> void stepWith(Real dt);
 	// the stages of one step, in order (theory.md §4 and §8.3); each times itself
 	void                         resetGridStage(bool wet);
@@ -155,6 +163,7 @@ private:
 	void                          injectInflowingWater();
 	std::vector<long>             inflowNearest_;
 	std::vector<Real>             inflowDepth_;
+	std::vector<long>             inflowBuffer_; // per inflow row: its buffer point (eq. 2.5), −1 where none
 	std::vector<Real>             solidRetention_, waterRetention_; // eq. 4.11b per node [-]
 	std::vector<std::string>      waterNames_;                      // per water set, for messages
 	PointFieldNames               fieldNames_;

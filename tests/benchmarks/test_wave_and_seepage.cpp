@@ -397,12 +397,21 @@ namespace {
 // Inflow (theory.md eq. 2.5): upward seepage at 0.8 i_c through a column whose drained base is an
 // inflow face and whose drained top lets the water leave into a sink. In the steady state the base
 // supplies the Darcy flux q = k i as new water points, the water leaving the top is removed, and
-// the water mass balance closes to round-off.
-TEST(Inflow, SuppliesTheDarcyFluxAndClosesTheWaterMassBalance)
+// the water mass balance closes to round-off. Both schemes; the semi-implicit one with PIC
+// transfers (with FLIP its water points gather next to the drained base at this permeability:
+// theory.md §8, Open).
+class Inflow : public ::testing::TestWithParam<TimeScheme> {};
+
+TEST_P(Inflow, SuppliesTheDarcyFluxAndClosesTheWaterMassBalance)
 {
 	const double g = 9.81, H = 0.5, h = 0.05, k = 0.05;
 	Column       c(H, h, k, g);
 	c.water.bulkModulus = 2.2e7; // Kw/n = 10 E_oed: the steady flux does not depend on Kw
+	if (GetParam() == TimeScheme::SemiImplicit) {
+		c.settings.scheme              = TimeScheme::SemiImplicit;
+		c.settings.pressureModeDamping = false;
+		c.settings.flipBlend           = 0;
+	}
 	const double gammaW = c.water.density * g, iCritical = (c.rhoSat() - c.water.density) / c.water.density, i = 0.8 * iCritical;
 	fixtures::setGeostatic(c.solid, c.fluid, c.soil, c.water, g, H);
 	c.domain.boundaries.walls[static_cast<int>(Face::ZMin)]        = { SolidWall::Fixed, WaterWall::Drained, gammaW * (H + i * H) };
@@ -434,13 +443,17 @@ TEST(Inflow, SuppliesTheDarcyFluxAndClosesTheWaterMassBalance)
 	std::printf("inflow: injected %.4e kg, removed %.4e kg, Darcy %.4e kg over %.1f s (one layer %.2e kg); balance residual %.1e\n", injected,
 	            removed, expected, duration, layerMass, (stored + c.solver->removedWaterMass() - initial - c.solver->injectedWaterMass()) / initial);
 	EXPECT_NEAR(stored + c.solver->removedWaterMass(), initial + c.solver->injectedWaterMass(), 1e-12 * initial);
-	// points enter whole: the supply over a window is the Darcy mass to within one point layer
-	EXPECT_NEAR(injected, expected, layerMass + 0.02 * expected);
-	EXPECT_NEAR(removed, expected, layerMass + 0.02 * expected);
+	// the face's buffer points grow with the water drawn in: the supply over a window is the Darcy
+	// mass to within the steady state's own error; points leave the top whole (one layer)
+	EXPECT_NEAR(injected, expected, 0.03 * expected);
+	EXPECT_NEAR(removed, expected, layerMass + 0.03 * expected);
 	// the water lattice near the inflow face stays as dense as it started: 2 point layers within 2s
 	int nearBase = 0;
 	for (const Vec3& x : c.fluid.position) nearBase += x.z() < h;
 	EXPECT_NEAR(nearBase, 8, 4);
 }
+
+INSTANTIATE_TEST_SUITE_P(Schemes, Inflow, ::testing::Values(TimeScheme::Explicit, TimeScheme::SemiImplicit),
+                         [](const ::testing::TestParamInfo<TimeScheme>& info) { return info.param == TimeScheme::Explicit ? "Explicit" : "SemiImplicit"; });
 
 } // namespace

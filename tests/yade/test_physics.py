@@ -226,13 +226,15 @@ def test_inflow_face_supplies_water_points_under_a_raised_head_and_the_balance_c
     start = solid.pos.copy()
     O.dt = 1e-3
     O.run(50, True)
-    assert engine.injectedWaterMass == 0 and engine.removedWaterMass == 0
+    # hydrostatic: no flow; only the gap the column's elastic settling opens and closes at the face
+    # (its points move by ~1 µm) is filled and emptied by the face's buffer point (eq. 2.5)
+    layer = 4 * fluid.mass[0]
+    assert engine.injectedWaterMass < 1e-3 * layer and engine.removedWaterMass < 1e-3 * layer
     steps = engine.solverSteps
     engine.drainedWaterTable = (float("-inf"),) * 4 + (height * 1.4, float("-inf"))  # i = 0.4 < i_c ≈ 1
     O.run(1, True)
     assert engine.solverSteps > steps  # the head changed in place: the solver was not rebuilt
     O.run(2000, True)  # 2 s at q/n = k i/n = 0.05 m/s: four point layers (4 points each) in and out
-    layer = 4 * fluid.mass[0]
     assert 3 * layer <= engine.injectedWaterMass <= 5 * layer
     assert 3 * layer <= engine.removedWaterMass <= 5 * layer
     assert fluid.mass.sum() + engine.removedWaterMass == pytest.approx(initial + engine.injectedWaterMass, rel=1e-12)
