@@ -10,8 +10,9 @@ between smooth walls. It starts undrained: p0 = q/2, σ′_xx = +q/2, σ′_zz =
 first rises above p0 (the Mandel–Cryer effect), then decays.
 
 Quick: h = a/10 (about 30 s on one core); full: h = a/20 (a few minutes). Writes DIR/centre_pressure.png and
-DIR/summary.json (centre p/p0 and the series at each T). The coarse column overshoots the series
-(theory.md §8, Open: the approximate projection's volume error).
+DIR/summary.json (centre p/p0 and the series at each T). Two defect corrections of the pressure per
+step (pressureCorrections = 2, theory.md §8.7b) keep the centre within 2% of the series; without
+them the slow drainage accumulates the stabilised projection's volume error (26% high at T = 0.05).
 """
 import argparse
 import json
@@ -53,7 +54,7 @@ O.engines = [MpmTwoPhaseEngine(label="mpm", domainMin=(0, 0, 0), domainMax=size,
                                #            xMin (symmetry) xMax (drained) yMin     yMax     zMin (symmetry) zMax
                                solidWalls=("slip",          "free",        "slip",  "slip",  "slip",         "plate"),
                                waterWalls=("impermeable",   "drained",     "impermeable", "impermeable", "impermeable", "impermeable"),
-                               faceTraction=[(0, 0, 0)] * 5 + [(0, 0, -LOAD)])]
+                               faceTraction=[(0, 0, 0)] * 5 + [(0, 0, -LOAD)], pressureCorrections=2)]
 
 start, rows = time.time(), []
 for tv in TIME_FACTORS:

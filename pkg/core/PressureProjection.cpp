@@ -340,6 +340,39 @@ namespace stages {
 	// Relative residual of the plate's response K⁻¹b (eq. 2.9) in the Sherman–Morrison solve.
 	constexpr Real plateResponseTolerance = 1e-10;
 
+	namespace {
+		// K x = rhs on the free nodes (with the plate's rank-one term by Sherman–Morrison), CG with a
+		// Jacobi preconditioner from `x` as the first guess; returns false when it does not converge.
+		bool solveFreeRows(PressureSystem& system, Eigen::Matrix<Real, Eigen::Dynamic, 1>& rhs, Eigen::Matrix<Real, Eigen::Dynamic, 1>& x, Real tolerance,
+		                   const Eigen::Matrix<Real, Eigen::Dynamic, 1>& coupling, PressureSolveReport& report)
+		{
+			const Real rhsNorm = rhs.norm(), typical = system.meanDiagonal;
+			if (!(rhsNorm > 0)) {
+				x.setZero(rhs.size());
+				return true;
+			}
+			Eigen::ConjugateGradient<Eigen::SparseMatrix<Real, Eigen::RowMajor>, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<Real>> cg;
+			cg.setTolerance(std::min<Real>(0.1, tolerance * typical / rhsNorm));
+			cg.setMaxIterations(std::max<long>(1000, 2 * rhs.size()));
+			cg.compute(system.matrix);
+			x                 = cg.solveWithGuess(rhs, x);
+			report.iterations += cg.iterations();
+			report.residual   = cg.error() * rhsNorm / typical;
+			bool converged    = cg.info() == Eigen::Success;
+			if (coupling.size() > 0 && converged && coupling.norm() > 0) {
+				// K⁻¹b multiplies a pressure-sized factor: it needs the relative accuracy of the pressure
+				// itself, not that of r (which is small in a slow consolidation)
+				cg.setTolerance(plateResponseTolerance);
+				const Eigen::Matrix<Real, Eigen::Dynamic, 1> response = cg.solve(coupling); // K⁻¹ b
+				converged = converged && cg.info() == Eigen::Success;
+				report.iterations += cg.iterations();
+				const Real c = system.plateScale;
+				x -= response * (c * coupling.dot(x) / (1 + c * coupling.dot(response)));
+			}
+			return converged && x.allFinite();
+		}
+	} // namespace
+
 	PressureSolveReport solvePressure(PressureSystem& system, Real tolerance)
 	{
 		PressureSolveReport report;
@@ -351,7 +384,6 @@ namespace stages {
 		for (std::size_t r = 0; r < active; ++r)
 			if (system.fixed[r]) system.nodalPressure[system.node[r]] = system.fixedValue[r];
 		if (n == 0) return report;
-		const Real typical = system.meanDiagonal;
 		// warm start: the last step's pressure at the same grid node
 		system.solution.setZero(n);
 		for (std::size_t e = 0; e < system.previousNode.size(); ++e) {
@@ -371,35 +403,13 @@ namespace stages {
 			}
 			system.rhs -= system.plateScale * fixedShare * coupling;
 		}
-		const Real rhsNorm = system.rhs.norm();
-		if (rhsNorm > 0) {
-			Eigen::ConjugateGradient<Eigen::SparseMatrix<Real, Eigen::RowMajor>, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<Real>> cg;
-			cg.setTolerance(std::min<Real>(0.1, tolerance * typical / rhsNorm));
-			cg.setMaxIterations(std::max<long>(1000, 2 * n));
-			cg.compute(system.matrix);
-			system.solution  = cg.solveWithGuess(system.rhs, system.solution);
-			report.iterations = cg.iterations();
-			report.residual   = cg.error() * rhsNorm / typical;
-			bool converged    = cg.info() == Eigen::Success;
-			if (plate && converged && coupling.norm() > 0) {
-				// K⁻¹b multiplies a pressure-sized factor: it needs the relative accuracy of the pressure
-				// itself, not that of r (which is small in a slow consolidation)
-				cg.setTolerance(plateResponseTolerance);
-				const Eigen::Matrix<Real, Eigen::Dynamic, 1> response = cg.solve(coupling); // K⁻¹ b
-				converged = converged && cg.info() == Eigen::Success;
-				report.iterations += cg.iterations();
-				const Real c = system.plateScale;
-				system.solution -= response * (c * coupling.dot(system.solution) / (1 + c * coupling.dot(response)));
-			}
-			if (!converged || !system.solution.allFinite()) {
-				std::ostringstream msg;
-				msg << "the pore-pressure solve did not converge: " << report.iterations << " conjugate-gradient iterations on " << n
-				    << " pressure nodes left a residual of " << report.residual << " Pa against pressureTolerance = " << tolerance
-				    << " Pa (check the time step, the permeability and that every water region touches a drained face or has compressible water)";
-				throw InstabilityError(msg.str());
-			}
-		} else {
-			system.solution.setZero(n);
+		if (!plate) coupling.resize(0);
+		if (!solveFreeRows(system, system.rhs, system.solution, tolerance, coupling, report)) {
+			std::ostringstream msg;
+			msg << "the pore-pressure solve did not converge: " << report.iterations << " conjugate-gradient iterations on " << n
+			    << " pressure nodes left a residual of " << report.residual << " Pa against pressureTolerance = " << tolerance
+			    << " Pa (check the time step, the permeability and that every water region touches a drained face or has compressible water)";
+			throw InstabilityError(msg.str());
 		}
 		if (plate) system.plateForce = coupling.dot(system.solution) + fixedShare;
 		system.previousNode.clear();
@@ -566,6 +576,112 @@ namespace stages {
 		return forms;
 	}
 
+	template <class Kernel>
+	PressureSolveReport correctPressureDefect(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids,
+	                                          std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs, const Vec3& gravity, const WaterParameters& water,
+	                                          const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, const PlateMotion* plate,
+	                                          Real dt, Real solidMassTolerance, Real waterMassTolerance, Real tolerance, int corrections, PressureSystem& system)
+	{
+		PressureSolveReport report;
+		const std::size_t   active = system.node.size(), nodes = grid.nodeCount();
+		const long          n      = system.matrix.rows();
+		if (n == 0 || corrections <= 0) return report;
+		const Real invKw = 1 / water.bulkModulus;
+		Eigen::Matrix<Real, Eigen::Dynamic, 1> coupling;
+		if (plate && !system.plateCoupling.empty() && system.plateScale > 0) {
+			coupling.setZero(n);
+			for (std::size_t r = 0; r < active; ++r)
+				if (!system.fixed[r]) coupling[system.unknown[r]] = system.plateCoupling[r];
+		}
+		std::vector<Vec3>                      ds(nodes), dw(nodes), mixture(nodes), relative(nodes), skeleton(nodes);
+		std::vector<Real>                      balance;
+		std::vector<std::vector<Real>>         balanceBuffers;
+		Eigen::Matrix<Real, Eigen::Dynamic, 1> residual(n), step(n);
+		for (int k = 0; k < corrections; ++k) {
+			const std::vector<Real>& q = system.nodalPressure;
+			// δ(q) = Δt M⁻¹ (B q + the faces' traction), walls held, the plate moved by c (b·q): the
+			// corrector's increments for q (eq. 8.8)
+			accumulatePressureForces<Kernel>(grid, fields, solids, sets, q, false, system);
+			forEachDrainedFaceTraction(grid, bcs, gravity, water.density, waterMassTolerance, fields,
+			                           [&](std::size_t I, const Vec3& traction) { system.forces[I].solid += traction; });
+			forEachPressureIncrement(fields, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, system,
+			                         [&](std::size_t i, const Vec3& s, const Vec3& w, const std::array<bool, 3>&) {
+				                         ds[i] = s;
+				                         dw[i] = w;
+			                         });
+			if (coupling.size() > 0) {
+				Real bq = 0;
+				for (std::size_t r = 0; r < active; ++r) bq += system.plateCoupling[r] * q[system.node[r]];
+				for (std::size_t c : constrained.plate) ds[constrained.node[c]][plate->axis] = dw[constrained.node[c]][plate->axis] = system.plateScale * bq;
+			}
+			for (std::size_t I = 0; I < nodes; ++I) {
+				const bool hasS = fields.solid[I].mass > solidMassTolerance;
+				const Real theta = system.skeletonShare[I];
+				skeleton[I] = hasS ? ds[I] : dw[I];
+				mixture[I]  = theta * ds[I] + (1 - theta) * dw[I];
+				relative[I] = theta * (dw[I] - ds[I]);
+			}
+			// C q/Δt + Bᵀδ at the pressure nodes (eqs. 8.2, 8.3), as the assembly takes Bᵀv*
+			balance.assign(active, 0);
+			for (const WaterPointSet* set : sets) {
+				const WaterPointSet& P = *set;
+				scatter(balance, balanceBuffers, P.size(), [&](std::size_t p, Real* rows) {
+					Weights1D w[3];
+					weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+					Real nn = 0, div = 0, qp = 0;
+					Vec3 rel = Vec3::Zero();
+					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+						nn += N * fields.porosity[I];
+						div += mixture[I].dot(dN);
+						rel += N * relative[I];
+						qp += N * q[I];
+					});
+					nn           = std::clamp<Real>(nn, minimumInterpolatedPorosity, 1);
+					const Real V = P.volume[p];
+					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+						if (system.row[I] >= 0) rows[system.row[I]] += N * V * (nn * invKw / dt * qp + nn * div) - V * nn * rel.dot(dN);
+					});
+				});
+			}
+			for (const SolidSet& set : solids) {
+				const SolidPointSet& P = *set.points;
+				scatter(balance, balanceBuffers, P.size(), [&](std::size_t p, Real* rows) {
+					Weights1D w[3];
+					weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+					Real nn = 0, div = 0;
+					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+						nn += N * fields.porosity[I];
+						div += skeleton[I].dot(dN);
+					});
+					nn                = std::clamp<Real>(nn, minimumInterpolatedPorosity, 1);
+					const Real source = P.volume[p] * (1 - nn) * div;
+					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+						if (system.row[I] >= 0) rows[system.row[I]] += N * source;
+					});
+				});
+			}
+			// the exact projection's residual b − (C q/Δt + Bᵀδ(q)) on the free rows, and K Δq = it
+			for (std::size_t r = 0; r < active; ++r)
+				if (!system.fixed[r]) residual[system.unknown[r]] = system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot] - balance[r];
+			step.setZero(n);
+			if (!solveFreeRows(system, residual, step, tolerance, coupling, report)) {
+				std::ostringstream msg;
+				msg << "the pore-pressure defect correction " << k + 1 << " did not converge: " << report.iterations << " conjugate-gradient iterations on " << n
+				    << " pressure nodes left a residual of " << report.residual << " Pa against pressureTolerance = " << tolerance << " Pa";
+				throw InstabilityError(msg.str());
+			}
+			for (std::size_t r = 0; r < active; ++r)
+				if (!system.fixed[r]) system.nodalPressure[system.node[r]] += step[system.unknown[r]];
+		}
+		// the warm start and the plate's force follow the corrected pressure
+		for (std::size_t e = 0; e < system.previousNode.size(); ++e) system.previousSolution[e] = system.nodalPressure[system.previousNode[e]];
+		if (!system.plateCoupling.empty()) {
+			system.plateForce = 0;
+			for (std::size_t r = 0; r < active; ++r) system.plateForce += system.plateCoupling[r] * system.nodalPressure[system.node[r]];
+		}
+		return report;
+	}
+
 #define MPM_INSTANTIATE_PROJECTION(K)                                                                                                      \
 	template void classifyPressureNodes<K>(const GridGeometry&, const GridFields&, const std::vector<WaterPointSet*>&, const BoundaryConditions&, \
 	                                       const Vec3&, Real, PressureSystem&);                                                         \
@@ -578,6 +694,10 @@ namespace stages {
 	                                   const BoundaryConditions&,                                                                             \
 	                                   const Vec3&, Real, const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,  \
 	                                   PressureSystem&);                                                                                     \
+	template PressureSolveReport correctPressureDefect<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&,                  \
+	                                                     std::vector<WaterPointSet*>&, const BoundaryConditions&, const Vec3&, const WaterParameters&, \
+	                                                     const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, const PlateMotion*, Real, Real, \
+	                                                     Real, Real, int, PressureSystem&);                                                          \
 	template ProjectionForms projectionForms<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&, \
 	                                            const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,                \
 	                                            const std::vector<Real>&, PressureSystem&);

@@ -125,6 +125,17 @@ namespace stages {
 	// it does not converge.
 	PressureSolveReport solvePressure(PressureSystem& system, Real tolerance);
 
+	// Defect correction towards the exact projection (theory.md §8.7b): `corrections` times,
+	// p ← p + K⁻¹ [b − (C p/Δt + Bᵀ δ(p))] with δ(p) the corrector's velocity increments for p
+	// (walls held, the plate moved), applied matrix-free. It converges because 0 ⪯ A ⪯ L
+	// (`projectionForms`): the iteration matrix I − K⁻¹K_A has its eigenvalues in [0, 1). Each
+	// correction costs three passes over the points and one solve. Returns the solves' report.
+	template <class Kernel>
+	PressureSolveReport correctPressureDefect(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids,
+	                                          std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs, const Vec3& gravity, const WaterParameters& water,
+	                                          const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, const PlateMotion* plate,
+	                                          Real dt, Real solidMassTolerance, Real waterMassTolerance, Real tolerance, int corrections, PressureSystem& system);
+
 	// Corrector (theory.md eq. 8.8): the point pressures p_wp = Σ S p_J (weights at t^n), their
 	// forces g^s, g^w with the drained faces' boundary terms (eq. 2.2), and the nodal velocity
 	// increments of the 2×2 drag system, with the wall

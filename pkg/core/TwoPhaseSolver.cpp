@@ -26,6 +26,8 @@ namespace {
 	// An inflow buffer point (theory.md eq. 2.5) is one whose half-length along the face normal is
 	// below the set's regular one by more than round-off.
 	constexpr double inflowBufferTolerance = 1e-9;
+	// More defect corrections per step than this buy nothing the discretisation keeps (theory.md §8.7b).
+	constexpr long maxPressureCorrections = 20;
 	// A water point reaching past a drained face by less than this share of its length is not cut
 	// (round-off, e.g. a column at rest), and one with less than it left inside leaves whole
 	// (theory.md eq. 2.4).
@@ -94,6 +96,7 @@ void SolverSettings::validate() const
 		                       " must lie in (0, 1)");
 	if (!gravity.allFinite()) throw InvalidParameter("gravity must have finite components [m s⁻²]");
 	requireOpenRange("pressureTolerance", pressureTolerance, 0, inf, "Pa");
+	if (!(pressureCorrections >= 0 && pressureCorrections <= maxPressureCorrections)) throwOutOfRange("pressureCorrections", pressureCorrections, "", "[0, " + std::to_string(maxPressureCorrections) + "]");
 	if (!(maxSubSteps >= 1)) throwOutOfRange("maxSubSteps", maxSubSteps, "", "[1, inf)");
 	// the relaxations of eqs. 4.17b–c and the suction seal of eq. 2.3b belong to the explicit scheme;
 	// the semi-implicit one is stable without them (theory.md §8.4)
@@ -358,6 +361,12 @@ template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
 	{
 		StageTimer t(stageSeconds_, Stage::SolvePressure); // eq. 8.7
 		lastPressureSolve_ = solvePressure(pressureSystem_, settings_.pressureTolerance);
+		if (settings_.pressureCorrections > 0) {
+			const PressureSolveReport more = correctPressureDefect<Kernel>(grid_, fields_, solids_, waters_, domain_.boundaries, g, water_, constrained_, heldSolid_,
+			                                                               constrained_.plate.empty() ? nullptr : &plate_, dt, solidMassTolerance_,
+			                                                               waterMassTolerance_, settings_.pressureTolerance, static_cast<int>(settings_.pressureCorrections), pressureSystem_);
+			lastPressureSolve_.iterations += more.iterations;
+		}
 	}
 	StageTimer t(stageSeconds_, Stage::CorrectVelocities); // eq. 8.8, then the wall friction (eq. 2.6) once
 	correctVelocities<Kernel>(grid_, fields_, solids_, waters_, domain_.boundaries, g, water_.density, constrained_, heldSolid_, dt, solidMassTolerance_,

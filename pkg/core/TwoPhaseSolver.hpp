@@ -25,6 +25,7 @@ struct SolverSettings {
 	bool          cellAveragedVolumetricRate = true; // theory.md eq. 4.17 (pressure and B-bar)
 	bool          pressureModeDamping        = false; // eqs. 4.17b–c (explicit scheme only): pressure modes the grid cannot see decay as a one-cell seepage would
 	Real          pressureTolerance          = 1e-3;  // δp [Pa] > 0: the semi-implicit pressure solve stops at the residual of a pressure error δp at a typical node (§8.7)
+	long          pressureCorrections        = 0;     // [-] ≥ 0: defect corrections of the semi-implicit pressure towards the exact projection per step (§8.7b)
 	Real          freeSurfaceThreshold       = 0;    // β [-], 0 ≤ β < 1: p = 0 on points filled below β (eq. 2.3); 0: off
 	bool          freeSurfaceHoldsSuction    = false; // eq. 2.3b (explicit scheme only): the surface keeps suction (p < 0) and releases only p > 0
 	long          maxSubSteps                = 100000; // N_max [-] ≥ 1: advance(dt) refuses a dt that needs more sub-steps than this (a mistyped step, not a run)

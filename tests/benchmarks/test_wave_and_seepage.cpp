@@ -457,3 +457,41 @@ INSTANTIATE_TEST_SUITE_P(Schemes, Inflow, ::testing::Values(TimeScheme::Explicit
                          [](const ::testing::TestParamInfo<TimeScheme>& info) { return info.param == TimeScheme::Explicit ? "Explicit" : "SemiImplicit"; });
 
 } // namespace
+
+namespace {
+
+// Sustained upward seepage on the semi-implicit step with FLIP transfers (theory.md §8.7b): 0.8 i_c
+// through a 1 m column (h = H/20, k = 1e-2 m/s) whose drained base is an inflow face, for 1.9 s
+// (the water rises 4 cm). Without the defect correction the stabilised projection's volume error
+// accumulates at the base and the flux drifts to −25% of Darcy's (σ′ 19% of γ′H); with two
+// corrections per step it holds (measured −0.2%, 1.1%).
+TEST(SemiImplicitSeepage, FlipThroughAnInflowFaceHoldsTheDarcyFluxWithTheDefectCorrection)
+{
+	const double g = 9.81, H = 1.0, h = 0.05, k = 1e-2;
+	Column       c(H, h, k, g);
+	c.settings.scheme              = TimeScheme::SemiImplicit;
+	c.settings.pressureModeDamping = false;
+	c.settings.pressureCorrections = 2;
+	const double gammaW = c.water.density * g, gammaBuoyant = (c.rhoSat() - c.water.density) * g, i = 0.8 * gammaBuoyant / gammaW;
+	fixtures::setGeostatic(c.solid, c.fluid, c.soil, c.water, g, H);
+	c.domain.boundaries.walls[static_cast<int>(Face::ZMin)]        = { SolidWall::Fixed, WaterWall::Drained, gammaW * (H + i * H) };
+	c.domain.boundaries.walls[static_cast<int>(Face::ZMin)].inflow = true;
+	c.domain.boundaries.walls[static_cast<int>(Face::ZMax)]        = { SolidWall::Free, WaterWall::Drained, 0.0 };
+	c.start();
+	c.run(1.9);
+	double flux = 0, sigmaError = 0;
+	int    count = 0;
+	for (std::size_t p = 0; p < c.solid.size(); ++p) {
+		const double z = c.solid.position[p].z();
+		if (z < 2 * h || z > H - 2 * h) continue; // the drained layers hold p by decree
+		flux += c.soil.porosity * (c.fluid.velocity[p].z() - c.solid.velocity[p].z());
+		sigmaError = std::max(sigmaError, std::abs(c.solid.effectiveStress[p][2] + (gammaBuoyant - i * gammaW) * (H - z)) / (gammaBuoyant * H));
+		++count;
+	}
+	const double fluxError = flux / count / (k * i) - 1;
+	std::printf("semi-implicit FLIP inflow seepage, 2 corrections: flux error %+.4f, max σ′zz error %.4f of γ′H\n", fluxError, sigmaError);
+	EXPECT_LT(std::abs(fluxError), 0.02);
+	EXPECT_LT(sigmaError, 0.03);
+}
+
+} // namespace

@@ -62,6 +62,8 @@ def test_read_only_outputs():
     (w.MpmTwoPhaseEngine, "timeStepFactor", 0.0, r"timeStepFactor = 0 is outside"),
     (w.MpmTwoPhaseEngine, "scheme", "implicit", r"scheme = 'implicit' is not one of: semi-implicit, explicit"),
     (w.MpmTwoPhaseEngine, "pressureTolerance", 0.0, r"pressureTolerance = 0 Pa is outside the valid range \(0, inf\)"),
+    (w.MpmTwoPhaseEngine, "pressureCorrections", 21, r"pressureCorrections = 21 is outside the valid range \[0, 20\]"),
+    (w.MpmTwoPhaseEngine, "pressureCorrections", -1, r"pressureCorrections = -1 is outside the valid range \[0, 20\]"),
     # the relaxations of the explicit scheme are refused with the (default) semi-implicit one
     (w.MpmTwoPhaseEngine, "pressureModeDamping", True, r"pressureModeDamping = True .* needs scheme = 'explicit'"),
 ])
