@@ -4,7 +4,9 @@
 // soil points, threads, soil point-steps per second, per second per thread, bytes per soil point,
 // and the share of each stage. A soil point is one solid point with its water point.
 //
-// Usage: mpm_bench CELLS_PER_SIDE STEPS REPEATS [dry]
+// Usage: mpm_bench CELLS_PER_SIDE STEPS REPEATS [dry|explicit|corrected]
+// `corrected`: the semi-implicit scheme with two defect corrections of the pressure per step
+// (pressureCorrections = 2, theory.md eq. 8.7b).
 // With `dry` the block has solid points only (single-phase): the soil-point column then counts
 // solid points.
 #include "core/TwoPhaseSolver.hpp"
@@ -42,11 +44,11 @@ long residentKiB()
 int main(int argc, char** argv)
 {
 	const std::string option = argc == 5 ? argv[4] : "";
-	if (argc < 4 || argc > 5 || (argc == 5 && option != "dry" && option != "explicit")) {
-		std::fprintf(stderr, "usage: %s CELLS_PER_SIDE STEPS REPEATS [dry|explicit]\n", argv[0]);
+	if (argc < 4 || argc > 5 || (argc == 5 && option != "dry" && option != "explicit" && option != "corrected")) {
+		std::fprintf(stderr, "usage: %s CELLS_PER_SIDE STEPS REPEATS [dry|explicit|corrected]\n", argv[0]);
 		return 2;
 	}
-	const bool dry = option == "dry", explicitScheme = option == "explicit";
+	const bool dry = option == "dry", explicitScheme = option == "explicit", corrected = option == "corrected";
 	const int    cells = std::atoi(argv[1]), steps = std::atoi(argv[2]), repeats = std::atoi(argv[3]);
 	const double h = 0.01, side = cells * h, g = 9.81;
 	const long   rssBefore = residentKiB();
@@ -68,6 +70,7 @@ int main(int argc, char** argv)
 	const Domain d = fixtures::columnDomain(Vec3::Constant(side), h);
 	SolverSettings s;
 	s.gravity = Vec3(0, 0, -g);
+	if (corrected) s.pressureCorrections = 2;
 	if (explicitScheme) {
 		s.scheme              = TimeScheme::Explicit;
 		s.pressureModeDamping = true; // as the explicit scheme runs in practice
@@ -102,7 +105,7 @@ int main(int argc, char** argv)
 	auto         after   = solver.stageSeconds();
 	double       total   = 0;
 	for (int i = 0; i < static_cast<int>(Stage::Count); ++i) total += after[i] - before[i];
-	std::printf("%s%zu\t%d\t%.4g\t%.4g\t%.0f\t%.3g\t%.3g\t%.1f", dry ? "dry " : explicitScheme ? "explicit " : "", n, threads, median, median / threads,
+	std::printf("%s%zu\t%d\t%.4g\t%.4g\t%.0f\t%.3g\t%.3g\t%.1f", dry ? "dry " : explicitScheme ? "explicit " : corrected ? "2 corrections " : "", n, threads, median, median / threads,
 	            1024.0 * (rssAfter - rssBefore) / n, dt, simulated[simulated.size() / 2], static_cast<double>(iterations) / (steps * repeats));
 	for (int i = 0; i < static_cast<int>(Stage::Count); ++i) std::printf("\t%s=%.1f", stageName(static_cast<Stage>(i)), 100 * (after[i] - before[i]) / total);
 	std::printf("\n");
