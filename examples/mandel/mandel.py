@@ -44,11 +44,10 @@ size = (HALF_WIDTH, CELL, HALF_HEIGHT)
 solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), size, CELL, soil, water, points_per_cell=2, geostatic=False)
 O.bodies.append([solid_body, water_body])
 solid, fluid = solid_body.shape, water_body.shape
-p0 = LOAD / 2
-stress = solid.stress
-stress[:, 0, 0], stress[:, 2, 2] = LOAD / 2, -LOAD / 2  # undrained start: σ_xx = 0 on the free sides, σ_zz = −q
-solid.stress = stress
-fluid.porePressure = np.full(fluid.count, p0)
+# undrained start under the plate: σ_zz = −q, free sides σ_xx = 0, plane strain ε_yy = 0; with
+# incompressible grains and water p0 = q/2, σ′_xx = +q/2, σ′_zz = −q/2
+_, p0 = yade_mpm.apply_undrained_load(solid_body, water_body, soil, water, stress={"zz": -LOAD, "xx": 0, "yz": 0, "xz": 0, "xy": 0},
+                                      strain={"yy": 0})
 
 O.engines = [MpmTwoPhaseEngine(label="mpm", domainMin=(0, 0, 0), domainMax=size, cellSize=CELL,
                                #            xMin (symmetry) xMax (drained) yMin     yMax     zMin (symmetry) zMax

@@ -35,11 +35,11 @@ self_test(_yade_mpm, yade.wrapper, yade.wrapper.Omega())
 
 from yade.wrapper import MpmHdf5Recorder, MpmSoilMat, MpmSolidPoints, MpmTwoPhaseEngine, MpmWaterMat, MpmWaterPoints  # noqa: E402
 from . import _scenefiles, analytical, builders, calibrate, dem, monitor, results, sandpile  # noqa: E402
-from .builders import saturated_block, saturated_points  # noqa: E402
+from .builders import apply_undrained_load, saturated_block, saturated_points  # noqa: E402
 from .monitor import progress  # noqa: E402
 
 _scenefiles.install()  # O.load / O.loadTmp name the file when a saved scene cannot be read
 
 __version__ = _buildinfo.package_version
 __all__ = ["MpmTwoPhaseEngine", "MpmSolidPoints", "MpmWaterPoints", "MpmSoilMat", "MpmWaterMat", "MpmHdf5Recorder", "YadeAbiMismatch",
-           "saturated_block", "saturated_points", "progress"]
+           "saturated_block", "saturated_points", "apply_undrained_load", "progress"]

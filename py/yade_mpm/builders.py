@@ -143,21 +143,33 @@ def sudden_uniaxial_load(solid_body, water_body, soil, water, load):
     """Add to a saturated block the undrained response to a vertical load `load` q [Pa] (compressive,
     > 0) applied in one step under uniaxial strain (an oedometer): the water takes p0 = q B with
     B = (Kw/n) / (E_oed + Kw/n) (analytical.undrained_pressure_ratio), the skeleton the rest,
-    Δσ′_zz = −(q − p0), Δσ′_xx = Δσ′_yy = ν/(1 − ν) Δσ′_zz. The bodies are those of saturated_block
-    (points at the same positions). Returns p0 [Pa]. The load itself still has to be applied
-    (e.g. extForce on the top points)."""
-    from . import analytical
+    Δσ′_zz = −(q − p0), Δσ′_xx = Δσ′_yy = ν/(1 − ν) Δσ′_zz (apply_undrained_load with those
+    conditions). Returns p0 [Pa]. The load itself still has to be applied (e.g. extForce on the top
+    points or the engine's faceTraction)."""
     if not (np.isfinite(load) and load > 0):
         raise ValueError("load = %r Pa is outside the valid range (0, inf)" % (load,))
+    _, p0 = apply_undrained_load(solid_body, water_body, soil, water, stress={"zz": -load},
+                                 strain={"xx": 0, "yy": 0, "yz": 0, "xz": 0, "xy": 0})
+    return p0
+
+
+def apply_undrained_load(solid_body, water_body, soil, water, stress=None, strain=None):
+    """Add the undrained response to a sudden, uniform load to a saturated point pair (the state
+    just after the load, before any drainage): each solid point's stress gains Δσ′ and each water
+    point's pressure Δp from `analytical.undrained_response` (stress/strain: the prescribed
+    components of the total stress increment [Pa] and of the strain [-], see there). E.g. an
+    oedometer under q: stress={'zz': -q}, strain={'xx': 0, 'yy': 0, 'yz': 0, 'xz': 0, 'xy': 0};
+    Mandel's specimen: stress={'zz': -q, 'xx': 0, 'yz': 0, 'xz': 0, 'xy': 0}, strain={'yy': 0}.
+
+    Returns (Δσ′ 3×3 [Pa], Δp [Pa]).
+    """
+    from . import analytical
+
     solid, fluid = solid_body.shape, water_body.shape
     if solid.count != fluid.count:
-        raise ValueError("sudden_uniaxial_load needs the solid and water points of one saturated block (%d and %d points)" % (solid.count, fluid.count))
-    p0 = load * analytical.undrained_pressure_ratio(soil.youngModulus, soil.poissonRatio, soil.porosity, water.bulkModulus)
-    increment = -(load - p0)
-    stress = solid.stress
-    stress[:, 2, 2] += increment
-    stress[:, 0, 0] += soil.poissonRatio / (1 - soil.poissonRatio) * increment
-    stress[:, 1, 1] += soil.poissonRatio / (1 - soil.poissonRatio) * increment
-    solid.stress = stress
-    fluid.porePressure = fluid.porePressure + p0
-    return p0
+        raise ValueError("apply_undrained_load needs the solid and water points of one saturated block (%d and %d points)" % (solid.count, fluid.count))
+    effective, pressure, _ = analytical.undrained_response(soil.youngModulus, soil.poissonRatio, soil.porosity, water.bulkModulus,
+                                                           stress=stress, strain=strain)
+    solid.stress = solid.stress + effective
+    fluid.porePressure = fluid.porePressure + pressure
+    return effective, pressure

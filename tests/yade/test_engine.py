@@ -285,6 +285,34 @@ def test_sudden_uniaxial_load_gives_the_undrained_start():
         yade_mpm.builders.sudden_uniaxial_load(solid_body, water_body, soil, water, -1.0)
 
 
+def test_undrained_load_under_mixed_conditions_matches_the_closed_forms():
+    """Issue 17 item 15: apply_undrained_load solves the undrained elastic response to a sudden load
+    with each stress/strain component prescribed once. Checked against three closed forms:
+    Mandel's start (σ_zz = −q, free sides σ_xx = 0, plane strain ε_yy = 0, incompressible grains and
+    water: p0 = q/2, σ′_xx = +q/2, σ′_zz = −q/2, σ′_yy = 0 since ν_u = 1/2); an isotropic load on
+    compressible water (Skempton's B = 1/(1 + n K/Kw), K = E/(3(1 − 2ν))); and the oedometer
+    (the uniaxial helper's p0). Missing or doubled components are refused."""
+    q = 10e3
+    soil = w.MpmSoilMat(youngModulus=10e6, poissonRatio=0.3, porosity=0.3)
+    incompressible = w.MpmWaterMat(bulkModulus=float("inf"))
+    solid_body, water_body = yade_mpm.saturated_block((0, 0, 0), (0.1, 0.1, 0.2), 0.1, soil, incompressible)
+    effective, p0 = yade_mpm.apply_undrained_load(solid_body, water_body, soil, incompressible,
+                                                  stress={"zz": -q, "xx": 0, "yz": 0, "xz": 0, "xy": 0}, strain={"yy": 0})
+    assert p0 == pytest.approx(q / 2, rel=1e-12)
+    assert np.allclose(np.diag(effective), [q / 2, 0, -q / 2], atol=1e-9 * q)
+    assert np.allclose(solid_body.shape.stress[:, 0, 0], q / 2) and np.allclose(water_body.shape.porePressure, q / 2)
+    water = w.MpmWaterMat(bulkModulus=2.2e8)
+    bulk = 10e6 / (3 * (1 - 2 * 0.3))
+    effective, p, _ = yade_mpm.analytical.undrained_response(10e6, 0.3, 0.3, 2.2e8, stress={k: (-q if k in ("xx", "yy", "zz") else 0)
+                                                                                         for k in ("xx", "yy", "zz", "yz", "xz", "xy")})
+    assert p == pytest.approx(q / (1 + 0.3 * bulk / 2.2e8), rel=1e-12)
+    assert np.allclose(effective, -(q - p) * np.eye(3), atol=1e-9 * q)
+    _, p_oed, _ = yade_mpm.analytical.undrained_response(10e6, 0.3, 0.3, 2.2e8, stress={"zz": -q}, strain={"xx": 0, "yy": 0, "yz": 0, "xz": 0, "xy": 0})
+    assert p_oed == pytest.approx(q * yade_mpm.analytical.undrained_pressure_ratio(10e6, 0.3, 0.3, 2.2e8), rel=1e-12)
+    with pytest.raises(ValueError, match=r"exactly once: \['zz'\] given twice, \['xy'\] missing"):
+        yade_mpm.analytical.undrained_response(10e6, 0.3, 0.3, 2.2e8, stress={"zz": -q}, strain={"zz": 0, "xx": 0, "yy": 0, "yz": 0, "xz": 0})
+
+
 def test_face_traction_is_a_per_face_vector_in_pascal():
     """faceTraction: six vectors (xMin..zMax) [Pa]; a non-finite component is refused naming the
     face; a change applies to a running solver in place (a load ramp needs no rebuild)."""
