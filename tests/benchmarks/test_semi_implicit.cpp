@@ -402,3 +402,91 @@ TEST(ProjectionStability, TheCompactOperatorBoundsTheExactOneWhereThePointsReach
 	// a drained soil above its water (the top two cells unsaturated)
 	EXPECT_LT(worstFormRatio(ShapeFunction::UGimp, 0, 0, 1.0, 0.9), 1);
 }
+
+namespace {
+
+// Mean over the element ζ ∈ [0, d] of p(ζ, t) for 1D diffusion (c) in a half-space drained at ζ = 0
+// (p = 0) from p = −p0 on [0, d] and 0 beyond: with s = 2√(ct), the odd extension gives
+// p = −(p0/2) [erf((d − ζ)/s) + 2 erf(ζ/s) − erf((d + ζ)/s)]; Simpson's rule on 400 intervals.
+double dilatedElementMeanSuction(double p0, double d, double c, double t)
+{
+	const double s = 2 * std::sqrt(c * t);
+	auto p = [&](double z) { return -0.5 * p0 * (std::erf((d - z) / s) + 2 * std::erf(z / s) - std::erf((d + z) / s)); };
+	const int n = 400;
+	double    sum = p(0) + p(d);
+	for (int i = 1; i < n; ++i) sum += (i % 2 ? 4 : 2) * p(d * i / n);
+	return sum * d / (3.0 * n) / d;
+}
+
+} // namespace
+
+// A dilating element next to a drained face (issue 14): a sand that dilates undrained goes into
+// suction, which must drain through the face on d²/c_v — the suction-holding seal of the explicit
+// scheme (eq. 2.3b) kept it 0.3–0.5 s in the sand pile where d²/c_v ≈ 4e-5 s. A column 0.5 m high
+// (h = d/8 = 6.25 mm, 80 cells), drained at its top, no gravity, k = 1e-5 m/s: the top d = 5 cm start
+// at p = −1 kPa with σ′ = −1 kPa I (total stress zero), the rest at rest. The element's mean
+// suction follows the half-space closed form within 0.05 p0 at t = 0.05…0.5 d²/c_v and falls to
+// half of p0 within 20% of the closed form's time (explicit, Kw = 2.2e8: measured 0.097 against
+// 0.089 d²/c_v; at h = d/4 0.124, +39%). The semi-implicit step fails it (theory.md §8, Open):
+// half time 0.19 d²/c_v at h = d/4 and 0.70 at d/8 (it worsens with refinement), with an asymmetry
+// the explicit step does not have (an element at +p0 drains twice too fast), so it is skipped there
+// with the measured numbers until that is found.
+class DilatingElement : public ::testing::TestWithParam<TimeScheme> {};
+
+TEST_P(DilatingElement, SuctionNextToADrainedFaceDecaysOnItsDrainageTime)
+{
+	if (GetParam() == TimeScheme::SemiImplicit)
+		GTEST_SKIP() << "open (theory.md §8): the semi-implicit step holds the suction — half time 0.70 d²/c_v against 0.089 at h = d/8";
+	const double    H = 0.5, h = 0.00625, d = 0.05, p0 = 1e3;
+	SoilParameters  soil;
+	WaterParameters water;
+	water.bulkModulus          = 2.2e8; // the explicit step follows the undrained wave
+	soil.youngModulus          = 10e6;
+	soil.poissonRatio          = 0.3;
+	soil.porosity              = 0.3;
+	soil.intrinsicPermeability = 1e-5 * water.viscosity / (water.density * g0); // k = 1e-5 m/s
+	const double cv = analytical::consolidationCoefficient(soil.intrinsicPermeability / water.viscosity, soil.constrainedModulus(), soil.porosity,
+	                                                       water.bulkModulus);
+	const double tDrain = d * d / cv;
+	const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(h, h, H), h, 2);
+	SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
+	WaterPointSet fluid = fixtures::waterLattice(l, soil.porosity, water.density);
+	for (std::size_t p = 0; p < fluid.size(); ++p)
+		if (fluid.position[p].z() > H - d) {
+			fluid.porePressure[p] = -p0;
+			solid.effectiveStress[p] << -p0, -p0, -p0, 0, 0, 0;
+		}
+	SolverSettings settings;
+	settings.scheme              = GetParam();
+	settings.pressureModeDamping = GetParam() == TimeScheme::Explicit; // the explicit scheme as it was validated
+	TwoPhaseSolver solver(fixtures::columnDomain(Vec3(h, h, H), h), settings);
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	auto meanSuction = [&] {
+		double sum = 0;
+		int    count = 0;
+		for (std::size_t p = 0; p < fluid.size(); ++p)
+			if (l.positions[p].z() > H - d) sum += fluid.porePressure[p], ++count;
+		return sum / count;
+	};
+	double time = 0, previousTime = 0, previousMean = -p0, halfTime = -1;
+	for (double f : { 0.02, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5 }) {
+		solver.advance(f * tDrain - time);
+		time           = f * tDrain;
+		const double m = meanSuction(), exact = dilatedElementMeanSuction(p0, d, cv, time);
+		std::printf("t = %.2f d²/c_v: element mean p = %.1f Pa, closed form %.1f Pa\n", f, m, exact);
+		if (f >= 0.05) {
+			EXPECT_NEAR(m, exact, 0.05 * p0) << "t = " << f << " d²/c_v";
+		}
+		if (halfTime < 0 && m > -0.5 * p0) halfTime = previousTime + (time - previousTime) * (-0.5 * p0 - previousMean) / (m - previousMean);
+		previousTime = time, previousMean = m;
+	}
+	// the closed form's half time, by bisection
+	double lo = 1e-6 * tDrain, hi = tDrain;
+	for (int i = 0; i < 60; ++i) (dilatedElementMeanSuction(p0, d, cv, 0.5 * (lo + hi)) < -0.5 * p0 ? lo : hi) = 0.5 * (lo + hi);
+	std::printf("half decay: %.3f d²/c_v, closed form %.3f d²/c_v\n", halfTime / tDrain, lo / tDrain);
+	ASSERT_GT(halfTime, 0);
+	EXPECT_NEAR(halfTime / lo, 1.0, 0.2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Schemes, DilatingElement, ::testing::Values(TimeScheme::Explicit, TimeScheme::SemiImplicit),
+                         [](const ::testing::TestParamInfo<TimeScheme>& info) { return std::string(fixtures::schemeName(info.param)); });
