@@ -44,6 +44,7 @@ namespace {
 ConstrainedNodes ConstrainedNodes::build(const GridGeometry& grid, const BoundaryConditions& bcs)
 {
 	ConstrainedNodes out;
+	out.positionOf.assign(grid.nodeCount(), -1);
 	for (int k = 0; k < grid.nodes[2]; ++k)
 		for (int j = 0; j < grid.nodes[1]; ++j)
 			for (int i = 0; i < grid.nodes[0]; ++i) {
@@ -51,6 +52,7 @@ ConstrainedNodes ConstrainedNodes::build(const GridGeometry& grid, const Boundar
 				if (!c.any()) continue;
 				if (c.contact()) out.contact.push_back(out.node.size());
 				if (c.plateAxis >= 0) out.plate.push_back(out.node.size());
+				out.positionOf[grid.index(i, j, k)] = static_cast<int>(out.node.size());
 				out.node.push_back(grid.index(i, j, k));
 				out.constraint.push_back(c);
 			}

@@ -495,15 +495,13 @@ namespace stages {
 		};
 		// `apply(i, ds, dw, mixture)`: mixture[d] where both forces act on one velocity (a node with one
 		// phase, or the water held along d with the skeleton free)
-		std::vector<int> constraintOf(nodes, -1);
-		for (std::size_t c = 0; c < constrained.node.size(); ++c) constraintOf[constrained.node[c]] = static_cast<int>(c);
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 		for (std::size_t i = 0; i < nodes; ++i) {
 			Vec3 ds, dw;
 			increments(i, ds, dw);
 			const bool           onePhase = !(fields.solid[i].mass > solidMassTolerance && fields.water[i].mass > waterMassTolerance);
 			std::array<bool, 3>  mixture { onePhase, onePhase, onePhase };
-			const int c = constraintOf[i];
+			const int c = constrained.positionOf[i];
 			if (c >= 0) {
 				// held components (theory.md §2): the same rules as in the predictor, for the increments
 				const NodeConstraint&    nc = constrained.constraint[c];

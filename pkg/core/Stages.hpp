@@ -71,6 +71,7 @@ struct ConstrainedNodes {
 	std::vector<NodeConstraint> constraint;
 	std::vector<std::size_t>    contact; // positions in node/constraint of nodes on a frictional (contact) wall
 	std::vector<std::size_t>    plate;   // positions in node/constraint of the nodes that move with the Plate wall
+	std::vector<int>            positionOf; // per grid node: its position in node/constraint, −1 where unconstrained
 	static ConstrainedNodes     build(const GridGeometry& grid, const BoundaryConditions& bcs);
 };
 

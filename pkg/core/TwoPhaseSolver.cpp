@@ -171,6 +171,11 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 	solids_ = std::move(solids);
 	waters_ = std::move(waters);
 	water_  = water;
+	// each water set's regular half-length, the size its inflow rows tile (eq. 2.5): water domains never
+	// grow, buffers and cut points only shrink, so the start's largest is it
+	regularHalfLength_.assign(waters_.size(), Vec3::Zero());
+	for (std::size_t w = 0; w < waters_.size(); ++w)
+		for (const Vec3& l : waters_[w]->halfLength) regularHalfLength_[w] = regularHalfLength_[w].cwiseMax(l);
 	waterNames_.clear();
 	for (std::size_t w = 0; w < waters_.size(); ++w) waterNames_.push_back(w < waterNames.size() ? waterNames[w] : "water set " + std::to_string(w));
 	// consolidation coefficient c_v = κ M / μw of the fastest-draining soil (eq. 4.17b)
@@ -588,11 +593,11 @@ void TwoPhaseSolver::injectInflowingWater()
 		const bool upperFace = face % 2 == 1;
 		const Real inward    = upperFace ? -1 : 1;
 		const Real plane     = upperFace ? upper[axis] : lower[axis];
-		for (WaterPointSet* w : waters_) {
+		for (std::size_t set = 0; set < waters_.size(); ++set) {
+			WaterPointSet* w = waters_[set];
 			if (w->size() == 0) continue;
-			Vec3 halfLength = Vec3::Zero(); // the regular points' (buffers are smaller along the normal)
-			for (std::size_t p = 0; p < w->size(); ++p) halfLength = halfLength.cwiseMax(w->halfLength[p]);
-			const Vec3 spacing = 2 * halfLength;
+			const Vec3& halfLength = regularHalfLength_[set]; // buffers are smaller along the normal
+			const Vec3  spacing    = 2 * halfLength;
 			if (!(spacing.minCoeff() > 0)) continue; // zero-size points do not tile the face
 			const Real s     = spacing[axis];
 			const long rows1 = static_cast<long>(std::ceil((upper[a1] - lower[a1]) / spacing[a1]));

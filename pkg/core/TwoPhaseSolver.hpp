@@ -164,7 +164,8 @@ private:
 	void                          injectInflowingWater();
 	std::vector<long>             inflowNearest_;
 	std::vector<Real>             inflowDepth_;
-	std::vector<long>             inflowBuffer_; // per inflow row: its buffer point (eq. 2.5), −1 where none
+	std::vector<long>             inflowBuffer_;
+	std::vector<Vec3>             regularHalfLength_; // per water set: the half-length its inflow rows tile (eq. 2.5) [m] // per inflow row: its buffer point (eq. 2.5), −1 where none
 	std::vector<Real>             solidRetention_, waterRetention_; // eq. 4.11b per node [-]
 	std::vector<std::string>      waterNames_;                      // per water set, for messages
 	PointFieldNames               fieldNames_;
