@@ -652,6 +652,37 @@ void TwoPhaseSolver::injectInflowingWater()
 			}
 			removeFlags_.assign(w->size(), 0);
 			bool anyRemoved = false;
+			// a row below the water table that no water point reaches any more (the water under a
+			// sloping phreatic surface leaves the face's top rows downwards) is wetted again from a
+			// neighbouring row: the reservoir touches the whole face below its level (Charny's dam
+			// drew a third less than Darcy's flux with the face's top rows left dry)
+			for (std::size_t row = 0; row < inflowNearest_.size(); ++row) {
+				if (inflowNearest_[row] >= 0 || inflowBuffer_[row] >= 0) continue;
+				const long r1 = static_cast<long>(row) / rows2, r2 = static_cast<long>(row) % rows2;
+				long       neighbour = -1;
+				for (const std::array<long, 2>& d : { std::array<long, 2> { 0, 1 }, { 0, -1 }, { 1, 0 }, { -1, 0 } }) {
+					const long n1 = r1 + d[0], n2 = r2 + d[1];
+					if (n1 < 0 || n1 >= rows1 || n2 < 0 || n2 >= rows2) continue;
+					const long other = inflowNearest_[n1 * rows2 + n2];
+					if (other >= 0 && inflowDepth_[n1 * rows2 + n2] < 1.5 * s && w->halfLength[other][axis] >= (1 - inflowBufferTolerance) * halfLength[axis]) {
+						neighbour = other;
+						break;
+					}
+				}
+				if (neighbour < 0) continue;
+				Vec3 x  = w->position[neighbour];
+				x[a1]   = lower[a1] + (r1 + 0.5) * spacing[a1];
+				x[a2]   = lower[a2] + (r2 + 0.5) * spacing[a2];
+				x[axis] = plane + inward * 0.5 * s; // a regular point on the face's first spacing
+				if (!wall.belowWaterTable(x, settings_.gravity) || x[a1] > upper[a1] || x[a2] > upper[a2]) continue;
+				const std::size_t q = w->appendCopyOf(static_cast<std::size_t>(neighbour));
+				w->position[q]      = x;
+				w->velocity[q]      = Vec3::Zero();
+				w->porePressure[q]  = wall.drainedPressureAt(x, settings_.gravity, water_.density);
+				injectedWaterMass_ += w->mass[q];
+				inflowNearest_[row] = static_cast<long>(q);
+				inflowDepth_[row]   = 0.5 * s;
+			}
 			for (std::size_t row = 0; row < inflowNearest_.size(); ++row) {
 				if (inflowNearest_[row] < 0) continue;
 				const std::size_t outer = static_cast<std::size_t>(inflowNearest_[row]);
