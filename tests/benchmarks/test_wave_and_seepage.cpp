@@ -504,10 +504,11 @@ namespace {
 // (k = 0.1 m/s, real water, semi-implicit). Darcy: q = k (H1 − H2)/L · D per unit width. The water
 // that carries it enters as new points at the inflow face (eq. 2.5) and leaves cut at the drained one
 // (eq. 2.4): both counts over a window of the steady state must be Darcy's, and the water mass balance
-// closes to round-off. Measured: PIC −0.006% in and out, FLIP −0.09% in, −0.06% out; balance 1e-15.
-class LateralSeepage : public ::testing::TestWithParam<double> {};
-
-TEST_P(LateralSeepage, InflowAndOutflowCarryTheDarcyDischarge)
+// closes to round-off. PIC transfers (flipBlend = 0): measured −0.006% in and out over the window
+// and steady to 4 s. With FLIP the same layer passes this window (−0.09%) but a velocity noise mode
+// grows from 0.6 s at the inflow face and throws a water point back out through it at 1.3 s (theory.md
+// §8 Open), so FLIP is not tested here.
+TEST(LateralSeepage, InflowAndOutflowCarryTheDarcyDischarge)
 {
 	const double    g = 9.81, L = 0.4, D = 0.2, h = 0.025, H1 = 0.3, H2 = 0.25, k = 0.1;
 	SoilParameters  soil;
@@ -538,7 +539,7 @@ TEST_P(LateralSeepage, InflowAndOutflowCarryTheDarcyDischarge)
 	s.gravity             = Vec3(0, 0, -g);
 	s.scheme              = TimeScheme::SemiImplicit;
 	s.pressureModeDamping = false;
-	s.flipBlend           = GetParam();
+	s.flipBlend           = 0;
 	TwoPhaseSolver solver(d, s);
 	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
 	double initial = 0;
@@ -550,14 +551,11 @@ TEST_P(LateralSeepage, InflowAndOutflowCarryTheDarcyDischarge)
 	for (double m : fluid.mass) stored += m;
 	const double darcy = water.density * k * (H1 - H2) / L * D * h * window; // kg over the window
 	const double injected = solver.injectedWaterMass() - injected0, removed = solver.removedWaterMass() - removed0;
-	std::printf("lateral seepage, flipBlend %.0f: injected %.5e, removed %.5e, Darcy %.5e kg; balance %.1e\n", GetParam(), injected, removed, darcy,
+	std::printf("lateral seepage, PIC: injected %.5e, removed %.5e, Darcy %.5e kg; balance %.1e\n", injected, removed, darcy,
 	            (stored + solver.removedWaterMass() - initial - solver.injectedWaterMass()) / initial);
 	EXPECT_NEAR(injected, darcy, 0.01 * darcy);
 	EXPECT_NEAR(removed, darcy, 0.01 * darcy);
 	EXPECT_NEAR(stored + solver.removedWaterMass(), initial + solver.injectedWaterMass(), 1e-12 * initial);
 }
-
-INSTANTIATE_TEST_SUITE_P(Blends, LateralSeepage, ::testing::Values(0.0, 1.0),
-                         [](const ::testing::TestParamInfo<double>& info) { return info.param == 0 ? "PIC" : "FLIP"; });
 
 } // namespace
