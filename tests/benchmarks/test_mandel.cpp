@@ -149,7 +149,8 @@ TEST(RigidPlate, ExplicitSchemeCarriesTheLoadDownToo)
 // (theory.md §8.7b), which Mandel's long, slow drainage under a rigid plate accumulates: the centre
 // reads 1.056, 1.154, 1.260 at T = 0.01, 0.02, 0.05 against 1.033, 1.047, 1.073. Two defect
 // corrections per step (pressureCorrections = 2) remove it: within 2% of p0 at T = 0.01…1, the
-// issue's criterion (measured 0.8, 1.4, 0.2, 0.7, 0.5, 0.5, 0.3%).
+// issue's criterion (measured 1.4, 1.3, 0.1, 0.2, 0.5, 0.3, 0.2% since eq. 8.9; 0.8, 1.4, 0.2, 0.7, 0.5,
+// 0.5, 0.3% before).
 TEST(Mandel, CryerRiseFollowsTheSeriesWithTheDefectCorrection)
 {
 	auto run = [](long corrections, const std::vector<double>& times) {
