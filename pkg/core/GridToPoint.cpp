@@ -14,7 +14,8 @@ namespace stages {
 
 	template <class Kernel>
 	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
-	                           const std::vector<Real>* retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt, Real flipBlend)
+	                           const std::vector<Real>* retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt, Real flipBlend,
+	                           const std::vector<char>* picPoints)
 	{
 		const std::size_t count   = points.size();
 		long              invalid = -1;
@@ -32,7 +33,8 @@ namespace stages {
 			});
 			// eq. 4.11 written as v̄ + α(v_p − Σ S v^n_I), the unresolved part damped by eq. 4.11b and
 			// the momentum the other phase's points lost to drag received (eq. 4.11c)
-			const Vec3 v        = vNew + (flipBlend * kept) * (points.velocity[p] - vOld) + gained;
+			const Real alpha    = picPoints && (*picPoints)[p] ? 0 : flipBlend; // eq. 4.11d: PIC in an inflow face's cell
+			const Vec3 v        = vNew + (alpha * kept) * (points.velocity[p] - vOld) + gained;
 			points.velocity[p]  = v;
 			points.position[p] += dt * vNew;
 			wrapPosition(grid, points.position[p]);
@@ -55,14 +57,15 @@ namespace stages {
 
 	template <class Kernel>
 	void scatterDragLoss(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Real>& retention, const MaterialPointSet& points,
-	                     Real flipBlend, std::vector<Vec3>& lost, std::vector<std::vector<Vec3>>& buffers)
+	                     Real flipBlend, const std::vector<char>* picPoints, std::vector<Vec3>& lost, std::vector<std::vector<Vec3>>& buffers)
 	{
 		scatter(lost, buffers, points.size(), [&](std::size_t p, Vec3* nodes) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, points.position[p], points.halfLength[p], w);
 			Vec3 vOld = Vec3::Zero();
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) { vOld += N * gridVelocity[I]; });
-			const Vec3 unresolved = flipBlend * points.mass[p] * (points.velocity[p] - vOld);
+			const Real alpha      = picPoints && (*picPoints)[p] ? 0 : flipBlend; // PIC points keep no unresolved part to hand over
+			const Vec3 unresolved = alpha * points.mass[p] * (points.velocity[p] - vOld);
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 				if (retention[I] < 1) nodes[I] += (N * (1 - retention[I])) * unresolved;
 			});
@@ -93,8 +96,8 @@ namespace stages {
 	}
 
 #define MPM_INSTANTIATE(K) \
-	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const std::vector<Real>*, const std::vector<Vec3>*, MaterialPointSet&, Real, Real); \
-	template void scatterDragLoss<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Real>&, const MaterialPointSet&, Real, std::vector<Vec3>&, std::vector<std::vector<Vec3>>&); \
+	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const std::vector<Real>*, const std::vector<Vec3>*, MaterialPointSet&, Real, Real, const std::vector<char>*); \
+	template void scatterDragLoss<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Real>&, const MaterialPointSet&, Real, const std::vector<char>*, std::vector<Vec3>&, std::vector<std::vector<Vec3>>&); \
 	template long firstPointOutsideGrid<K>(const GridGeometry&, const MaterialPointSet&);
 
 	MPM_INSTANTIATE(LinearKernel)

@@ -152,7 +152,7 @@ namespace stages {
 	template <class Kernel>
 	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
 	                           const std::vector<Real>* retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt,
-	                           Real flipBlend);
+	                           Real flipBlend, const std::vector<char>* picPoints = nullptr);
 
 	// theory.md eq. 4.11b: per node, the factor 1/(1 + Δt Q_I/m_I) by which the implicit drag Q_I
 	// damps, within one step, a velocity of this phase's points that the other phase does not share
@@ -164,7 +164,7 @@ namespace stages {
 	// the other phase at that node, so the drag stays internal and the total momentum is kept.
 	template <class Kernel>
 	void scatterDragLoss(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Real>& retention, const MaterialPointSet& points,
-	                     Real flipBlend, std::vector<Vec3>& lost, std::vector<std::vector<Vec3>>& buffers);
+	                     Real flipBlend, const std::vector<char>* picPoints, std::vector<Vec3>& lost, std::vector<std::vector<Vec3>>& buffers);
 
 	// Step 8 (theory.md eq. 4.12): MUSL re-map of the point momenta of one phase to the grid,
 	// written to `remapped` (v̂_I), then the wall constraints of that phase. Momentum and mass are

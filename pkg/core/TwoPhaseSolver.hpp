@@ -165,10 +165,12 @@ private:
 	Real                          removedWaterMass_   = 0;     // water mass removed by sinks and at the grid's edge [kg]
 	Real                          injectedWaterMass_  = 0;     // water mass supplied through inflow faces [kg]
 	void                          injectInflowingWater();
+	void                          markInflowCellPoints();
 	std::vector<long>             inflowNearest_;
 	std::vector<Real>             inflowDepth_;
-	std::vector<long>             inflowBuffer_;
-	std::vector<Vec3>             regularHalfLength_; // per water set: the half-length its inflow rows tile (eq. 2.5) [m] // per inflow row: its buffer point (eq. 2.5), −1 where none
+	std::vector<long>             inflowBuffer_; // per inflow row: its buffer point (eq. 2.5), −1 where none
+	std::vector<std::vector<char>> inflowCell_; // per water set and point: within a cell of an inflow face, moved by PIC (eq. 4.11d)
+	std::vector<Vec3>             regularHalfLength_; // per water set: the half-length its inflow rows tile (eq. 2.5) [m]
 	std::vector<Real>             solidRetention_, waterRetention_; // eq. 4.11b per node [-]
 	std::vector<std::string>      waterNames_;                      // per water set, for messages
 	PointFieldNames               fieldNames_;

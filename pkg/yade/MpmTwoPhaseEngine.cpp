@@ -224,7 +224,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		valueAttr<E>("gravity", [](E& e) -> auto& { return e.settings_.gravity; }, "Gravitational acceleration acting on both phases b [m s⁻²]"),
 		valueAttr<E>("timeStepFactor", [](E& e) -> auto& { return e.settings_.timeStepFactor; }, "Safety factor C on the critical time step [-], 0 < C ≤ 1; O.dt is split into sub-steps no larger than C × criticalTimeStep"),
 		valueAttr<E>("maxSubSteps", [](E& e) -> auto& { return e.settings_.maxSubSteps; }, "Most sub-steps one O.dt may be split into [-], ≥ 1: an O.dt that would need more (a mistyped step, e.g. 10 s for a 1e-4 s critical step) is refused before any work, naming O.dt, criticalTimeStep and the sub-steps needed"),
-		valueAttr<E>("flipBlend", [](E& e) -> auto& { return e.settings_.flipBlend; }, "FLIP/PIC blend α of the grid-to-point velocity update [-], 0 ≤ α ≤ 1 (1 = pure FLIP, 0 = PIC)"),
+		valueAttr<E>("flipBlend", [](E& e) -> auto& { return e.settings_.flipBlend; }, "FLIP/PIC blend α of the grid-to-point velocity update [-], 0 ≤ α ≤ 1 (1 = pure FLIP, 0 = PIC); the water in the cell next to an inflow face always moves by PIC (theory.md eq. 4.11d)"),
 		valueAttr<E>("domainMin", [](E& e) -> auto& { return e.domain_.lower; }, "Lower corner of the domain box, whose faces are the walls [m]"),
 		valueAttr<E>("domainMax", [](E& e) -> auto& { return e.domain_.upper; }, "Upper corner of the domain box; each extent a whole number of cells [m]"),
 		valueAttr<E>("cellSize", [](E& e) -> auto& { return e.domain_.cellSize; }, "Cell size h of the background grid (cubic cells) [m]"),
