@@ -167,7 +167,7 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 			for (const SolidSet& set : solids)
 				for (std::size_t p = 0; p < set.points->size(); ++p)
 					if (std::abs(set.points->position[p][axis] - plane) < grid_.cellSize)
-						throw InvalidParameter(std::string("face ") + faceName(f) + ": solidWalls '" + "free" + "' with waterWalls 'impermeable' (an undrained face over a free skeleton, which " +
+						throw InvalidParameter(std::string("face ") + faceName(f) + ": solidWalls 'free' with waterWalls 'impermeable' (an undrained face over a free skeleton, which " +
 						                       set.name + " reaches) is not supported by scheme = 'semi-implicit' yet (its projection is unstable there, theory.md §8 Open): use scheme = 'explicit', a 'drained' or 'free' water wall, or a skeleton wall ('slip', 'fixed', 'plate')");
 		}
 	solids_ = std::move(solids);
@@ -291,10 +291,11 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	integrateMomentum(dt, wet, semiImplicit);     // Step 6, eqs. 4.8–4.10 (semi-implicit: predictor S1)
 	if (semiImplicit) projectPressure<Kernel>(dt); // S2–S3, eqs. 8.7–8.8
 	const bool projectedRates = semiImplicit && settings_.shapeFunction != ShapeFunction::Linear;
-	if (projectedRates) skeletonRatesFromProjection<Kernel>(); // S4a, eq. 8.9
+	if (projectedRates) skeletonRates<Kernel>();  // S4a, eq. 8.9: from v^{n+1} at x^n
 	movePoints<Kernel>(dt);                       // Step 7, eq. 4.11; water in and out, eqs. 2.4–2.5
 	remap<Kernel>(wet, !projectedRates);          // Step 8, eq. 4.12
-	updateSkeleton<Kernel>(dt, projectedRates);   // Step 9, eqs. 4.13–4.15, §7
+	if (!projectedRates) skeletonRates<Kernel>(); // eq. 4.13, from the re-mapped v̂ at x^{n+1}
+	updateSkeleton(dt);                           // Step 9, eqs. 4.13–4.15, §7
 	updateWater<Kernel>(dt, semiImplicit);        // Step 10, eqs. 4.16–4.17c, 2.1, 2.3 (semi-implicit: S4, the volume only)
 	updateDomains();                              // Step 11, eq. 3.3
 }
@@ -454,27 +455,28 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 	throwIfOutsideGrid(false);
 }
 
-// S4a (theory.md eq. 8.9): with GIMP the semi-implicit skeleton strains with the projected
-// velocities v^{n+1} and the weights at x^n — the field and the points whose volume balance the
-// projection held (eq. 8.2). The MUSL re-map would replace v^{n+1} at the nodes the skeleton fills in
+// The skeleton's velocity gradients (eq. 4.13) and, with cell averaging, their cell-averaged traces
+// (eq. 4.17), from fields_.solidVelocityNew at the points' current positions. Called after the re-map
+// (MUSL, eq. 4.12) or, for S4a (theory.md eq. 8.9), before the points move: with GIMP the
+// semi-implicit skeleton strains with the projected velocities v^{n+1} and the weights at x^n — the
+// field and the points whose volume balance the projection held (eq. 8.2). The MUSL re-map would replace v^{n+1} at the nodes the skeleton fills in
 // part (its surfaces) by a smoothed field the pressure never saw: suction next to a drained face
 // then never drained (half time 0.70 against 0.089 d²/c_v). Taken before the points move: with the
 // weights at x^{n+1}, a node that the points reach only after the move (its velocity 0, it had no
 // mass) strains a translating body (measured: 2 kPa in a block carried 0.25 m across cells).
-template <class Kernel> void TwoPhaseSolver::skeletonRatesFromProjection()
+template <class Kernel> void TwoPhaseSolver::skeletonRates()
 {
 	StageTimer t(stageSeconds_, Stage::UpdateSolidStress);
 	const bool average = settings_.cellAveragedVolumetricRate;
-	startGradients_.resize(solids_.size());
-	startVolumetric_.resize(solids_.size());
+	skeletonGradients_.resize(solids_.size());
+	skeletonVolumetric_.resize(solids_.size());
 	for (std::size_t s = 0; s < solids_.size(); ++s) {
-		stages::computeVelocityGradients<Kernel>(grid_, fields_.solidVelocityNew, *solids_[s].points, startGradients_[s]);
-		if (average) {
-			std::vector<Real>& rate = startVolumetric_[s];
-			rate.resize(startGradients_[s].size());
-			for (std::size_t p = 0; p < rate.size(); ++p) rate[p] = startGradients_[s][p].trace();
-			stages::averageOverCells(grid_, *solids_[s].points, rate, cellSum_, cellVolume_);
-		}
+		stages::computeVelocityGradients<Kernel>(grid_, fields_.solidVelocityNew, *solids_[s].points, skeletonGradients_[s]);
+		if (!average) continue;
+		std::vector<Real>& rate = skeletonVolumetric_[s];
+		rate.resize(skeletonGradients_[s].size());
+		for (std::size_t p = 0; p < rate.size(); ++p) rate[p] = skeletonGradients_[s][p].trace();
+		stages::averageOverCells(grid_, *solids_[s].points, rate, cellSum_, cellVolume_);
 	}
 }
 
@@ -488,25 +490,11 @@ template <class Kernel> void TwoPhaseSolver::remap(bool wet, bool solid)
 	if (wet) stages::remapVelocities<Kernel>(grid_, waterSets, waterMassTolerance_, constrained_, false, fields_.waterVelocityNew, workspace_);
 }
 
-// ratesFromProjection: the rates of S4a (eq. 8.9) were taken before the points moved.
-template <class Kernel> void TwoPhaseSolver::updateSkeleton(Real dt, bool ratesFromProjection)
+void TwoPhaseSolver::updateSkeleton(Real dt)
 {
-	using namespace stages;
 	StageTimer t(stageSeconds_, Stage::UpdateSolidStress);
 	const bool average = settings_.cellAveragedVolumetricRate;
-	if (ratesFromProjection) {
-		for (std::size_t s = 0; s < solids_.size(); ++s) updateSolidStress(startGradients_[s], average ? &startVolumetric_[s] : nullptr, solids_[s], dt);
-		return;
-	}
-	for (SolidSet& s : solids_) {
-		computeVelocityGradients<Kernel>(grid_, fields_.solidVelocityNew, *s.points, velocityGradients_);
-		if (average) {
-			volumetricRate_.resize(velocityGradients_.size());
-			for (std::size_t p = 0; p < velocityGradients_.size(); ++p) volumetricRate_[p] = velocityGradients_[p].trace();
-			averageOverCells(grid_, *s.points, volumetricRate_, cellSum_, cellVolume_);
-		}
-		updateSolidStress(velocityGradients_, average ? &volumetricRate_ : nullptr, s, dt);
-	}
+	for (std::size_t s = 0; s < solids_.size(); ++s) stages::updateSolidStress(skeletonGradients_[s], average ? &skeletonVolumetric_[s] : nullptr, solids_[s], dt);
 }
 
 template <class Kernel> void TwoPhaseSolver::updateWater(Real dt, bool semiImplicit)
@@ -641,9 +629,21 @@ void TwoPhaseSolver::injectInflowingWater()
 			inflowNearest_.assign(rows1 * rows2, -1);
 			inflowDepth_.assign(rows1 * rows2, inf);
 			inflowBuffer_.assign(rows1 * rows2, -1);
+			inflowCoverage_.assign(rows1 * rows2, 0);
 			for (std::size_t p = 0; p < w->size(); ++p) {
 				const Vec3& x     = w->position[p];
+				const Vec3& l     = w->halfLength[p];
 				const Real  depth = inward * (x[axis] - plane);
+				if (depth - l[axis] < s) { // its domain reaches the face's first spacing: the share of each row's patch it covers
+					const long lo1 = static_cast<long>(std::floor((x[a1] - l[a1] - lower[a1]) / spacing[a1]));
+					const long lo2 = static_cast<long>(std::floor((x[a2] - l[a2] - lower[a2]) / spacing[a2]));
+					for (long r1 = std::max<long>(0, lo1); r1 <= std::min<long>(rows1 - 1, lo1 + 1); ++r1)
+						for (long r2 = std::max<long>(0, lo2); r2 <= std::min<long>(rows2 - 1, lo2 + 1); ++r2) {
+							const Real o1 = std::min(x[a1] + l[a1], lower[a1] + (r1 + 1) * spacing[a1]) - std::max(x[a1] - l[a1], lower[a1] + r1 * spacing[a1]);
+							const Real o2 = std::min(x[a2] + l[a2], lower[a2] + (r2 + 1) * spacing[a2]) - std::max(x[a2] - l[a2], lower[a2] + r2 * spacing[a2]);
+							if (o1 > 0 && o2 > 0) inflowCoverage_[r1 * rows2 + r2] += o1 * o2 / (spacing[a1] * spacing[a2]);
+						}
+				}
 				if (!(depth >= 0 && depth < 2.5 * s)) continue;
 				const long r1 = static_cast<long>(std::floor((x[a1] - lower[a1]) / spacing[a1]));
 				const long r2 = static_cast<long>(std::floor((x[a2] - lower[a2]) / spacing[a2]));
@@ -664,19 +664,6 @@ void TwoPhaseSolver::injectInflowingWater()
 			// patch of the face no water point covers: points that drift across rows (flow along the
 			// face) still wet it, and a point added there packed the face's cell with water (Charny's
 			// dam with FLIP: 1.8 times its volume by 2.7 s)
-			inflowCoverage_.assign(inflowNearest_.size(), 0);
-			for (std::size_t p = 0; p < w->size(); ++p) {
-				const Vec3& x = w->position[p];
-				const Vec3& l = w->halfLength[p];
-				if (!(inward * (x[axis] - plane) - l[axis] < s)) continue; // its domain does not reach the face's first spacing
-				const long lo1 = static_cast<long>(std::floor((x[a1] - l[a1] - lower[a1]) / spacing[a1])), lo2 = static_cast<long>(std::floor((x[a2] - l[a2] - lower[a2]) / spacing[a2]));
-				for (long r1 = std::max<long>(0, lo1); r1 <= std::min<long>(rows1 - 1, lo1 + 1); ++r1)
-					for (long r2 = std::max<long>(0, lo2); r2 <= std::min<long>(rows2 - 1, lo2 + 1); ++r2) {
-						const Real o1 = std::min(x[a1] + l[a1], lower[a1] + (r1 + 1) * spacing[a1]) - std::max(x[a1] - l[a1], lower[a1] + r1 * spacing[a1]);
-						const Real o2 = std::min(x[a2] + l[a2], lower[a2] + (r2 + 1) * spacing[a2]) - std::max(x[a2] - l[a2], lower[a2] + r2 * spacing[a2]);
-						if (o1 > 0 && o2 > 0) inflowCoverage_[r1 * rows2 + r2] += o1 * o2 / (spacing[a1] * spacing[a2]);
-					}
-			}
 			for (std::size_t row = 0; row < inflowNearest_.size(); ++row) {
 				if (inflowNearest_[row] >= 0 || inflowBuffer_[row] >= 0 || inflowCoverage_[row] > uncoveredRow) continue;
 				const long r1 = static_cast<long>(row) / rows2, r2 = static_cast<long>(row) % rows2;
@@ -685,7 +672,7 @@ void TwoPhaseSolver::injectInflowingWater()
 					const long n1 = r1 + d[0], n2 = r2 + d[1];
 					if (n1 < 0 || n1 >= rows1 || n2 < 0 || n2 >= rows2) continue;
 					const long other = inflowNearest_[n1 * rows2 + n2];
-					if (other >= 0 && inflowDepth_[n1 * rows2 + n2] < 1.5 * s && w->halfLength[other][axis] >= (1 - inflowBufferTolerance) * halfLength[axis]) {
+					if (other >= 0 && inflowDepth_[n1 * rows2 + n2] < 1.5 * s) { // a regular point (buffers are kept apart) at the face
 						neighbour = other;
 						break;
 					}
@@ -697,8 +684,7 @@ void TwoPhaseSolver::injectInflowingWater()
 				x[axis] = plane + inward * 0.5 * s; // a regular point on the face's first spacing
 				if (!wall.belowWaterTable(x, settings_.gravity) || x[a1] > upper[a1] || x[a2] > upper[a2]) continue;
 				const std::size_t q = w->appendCopyOf(static_cast<std::size_t>(neighbour));
-				w->position[q]      = x;
-				w->velocity[q]      = Vec3::Zero();
+				w->position[q]      = x; // with its neighbour's velocity, as a buffer takes its row's
 				w->porePressure[q]  = wall.drainedPressureAt(x, settings_.gravity, water_.density);
 				injectedWaterMass_ += w->mass[q];
 				inflowNearest_[row] = static_cast<long>(q);
@@ -758,10 +744,12 @@ void TwoPhaseSolver::injectInflowingWater()
 // a periodic layer without any face shows the interior needs none of it.
 void TwoPhaseSolver::markInflowCellPoints()
 {
-	inflowCell_.clear();
 	bool inflow = false;
 	for (int f = 0; f < faceCount; ++f) inflow = inflow || domain_.boundaries.walls[f].inflow;
-	if (!inflow || settings_.flipBlend == 0) return;
+	if (!inflow || settings_.flipBlend == 0) {
+		inflowCell_.clear(); // none marked: every point takes flipBlend
+		return;
+	}
 	const Vec3 lower = grid_.lower(), upper = grid_.upper();
 	inflowCell_.resize(waters_.size());
 	for (std::size_t s = 0; s < waters_.size(); ++s) {

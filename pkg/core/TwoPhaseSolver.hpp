@@ -136,9 +136,9 @@ private:
 	void                         integrateMomentum(Real dt, bool wet, bool semiImplicit);
 	template <class Kernel> void projectPressure(Real dt);
 	template <class Kernel> void movePoints(Real dt);
-	template <class Kernel> void skeletonRatesFromProjection();
+	template <class Kernel> void skeletonRates();
 	template <class Kernel> void remap(bool wet, bool solid);
-	template <class Kernel> void updateSkeleton(Real dt, bool ratesFromProjection);
+	void                         updateSkeleton(Real dt);
 	template <class Kernel> void updateWater(Real dt, bool semiImplicit);
 	void                         updateDomains();
 	// A point whose stencil leaves the grid: bad input at `setup` (InvalidParameter), else InstabilityError.
@@ -151,10 +151,9 @@ private:
 	ConstrainedNodes              constrained_;
 	PlateMotion                   plate_; // the rigid plate's motion this step (eq. 2.9), when there is one
 	ScatterWorkspace              workspace_;
-	std::vector<Mat3>             velocityGradients_;
-	std::vector<std::vector<Mat3>> startGradients_;  // per solid set: S4a's velocity gradients (eq. 8.9)
-	std::vector<std::vector<Real>> startVolumetric_; // per solid set: their cell-averaged traces
-	std::vector<Real>             volumetricRate_, pressureRate_, waterDivergence_, cellSum_, cellVolume_;
+	std::vector<std::vector<Mat3>> skeletonGradients_;  // per solid set: velocity gradients L_p of this step (eqs. 4.13, 8.9)
+	std::vector<std::vector<Real>> skeletonVolumetric_; // per solid set: their cell-averaged traces (eq. 4.17)
+	std::vector<Real>             pressureRate_, waterDivergence_, cellSum_, cellVolume_;
 	std::vector<SolidSet>         solids_;
 	std::vector<WaterPointSet*>   waters_;
 	WaterParameters               water_;

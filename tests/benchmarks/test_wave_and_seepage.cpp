@@ -563,3 +563,99 @@ INSTANTIATE_TEST_SUITE_P(Blends, LateralSeepage, ::testing::Values(0.0, 1.0),
                          [](const ::testing::TestParamInfo<double>& info) { return info.param == 0 ? "PIC" : "FLIP"; });
 
 } // namespace
+
+namespace {
+
+// Dry rows of an inflow face (theory.md eq. 2.5): where the reservoir's level lies above the water
+// in the soil, the face's rows between them are wetted — one regular point per row on the face's
+// first spacing, from a wet neighbouring row, once — and none above the level. A slab 0.2 m long,
+// one cell (5 cm) wide and 0.2 m high, 2 points per cell and axis (spacing 2.5 cm: 2 rows across,
+// 8 up the face), soil throughout, water below z0 = 0.1 m, the face x = 0 an inflow face under the
+// level 0.15 m; k = 1e-5 m/s, so that in these few steps the water hardly moves and only the rule acts.
+// Rows 4 and 5 (centres 0.1125, 0.1375 m) lie below the level, rows 6 and 7 above it: after 6 steps
+// exactly 2 × 2 new regular points sit in the first spacing above z0, all below the level, and
+// 6 more steps add none (each row wetted once); the mass they carry is counted as injected.
+// Second case, the coverage check: row 4 holds no point's centre but the domains of the points of
+// rows 3 and 5 that drifted towards it (as water flowing along the face leaves them) cover 0.3 + 0.3
+// of its patch: it is wet and must get no point (one there doubled the water of the patch; without
+// the check 2 points are added); row 5 has its point, rows 6–7 lie above the level: none added.
+struct DryRows {
+	std::size_t newPoints = 0, aboveLevel = 0, inRow4 = 0;
+	double      injected = 0, pointMass = 0, balance = 0;
+};
+
+DryRows runDryRows(bool drifted, int steps)
+{
+	const double    g = 9.81, L = 0.2, W = 0.05, D = 0.2, h = 0.05, s = h / 2, z0 = 0.1, level = 0.15;
+	SoilParameters  soil;
+	WaterParameters water;
+	soil.porosity              = 0.4;
+	soil.intrinsicPermeability = 1e-5 * water.viscosity / (water.density * g);
+	const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(L, W, D), h, 2);
+	SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
+	fixtures::Lattice wet;
+	wet.spacing = l.spacing;
+	for (const Vec3& x : l.positions) {
+		if (x.z() > z0) continue;
+		Vec3 y = x;
+		// the face column's row 3 (centre 0.0875 m) and a point of row 5 (0.1375 m), both drifted 0.3 s
+		// towards row 4, whose patch their domains then cover 0.3 + 0.3
+		const bool faceRow3 = drifted && x.x() < s && std::abs(x.z() - (3.5 * s)) < 1e-9;
+		if (faceRow3) y.z() += 0.3 * s;
+		wet.positions.push_back(y);
+		if (faceRow3) wet.positions.push_back(Vec3(x.x(), x.y(), 5.5 * s - 0.3 * s));
+	}
+	WaterPointSet fluid = fixtures::waterLattice(wet, soil.porosity, water.density);
+	// at rest: hydrostatic water below z0, the skeleton carrying the soil above it (dry above z0)
+	const double k0 = soil.poissonRatio / (1 - soil.poissonRatio);
+	for (std::size_t p = 0; p < solid.size(); ++p) {
+		const double z = solid.position[p].z(), pw = water.density * g * std::max(0.0, z0 - z);
+		const double sz = -g * ((1 - soil.porosity) * soil.density * (D - z) + soil.porosity * water.density * std::max(0.0, z0 - z)) + pw;
+		solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
+	}
+	for (std::size_t p = 0; p < fluid.size(); ++p) fluid.porePressure[p] = std::max(0.0, water.density * g * (z0 - fluid.position[p].z()));
+	Domain d = fixtures::columnDomain(Vec3(L, W, D), h);
+	d.boundaries.walls[static_cast<int>(Face::XMin)]            = { SolidWall::Slip, WaterWall::Drained, 0.0 };
+	d.boundaries.walls[static_cast<int>(Face::XMin)].waterTable = level;
+	d.boundaries.walls[static_cast<int>(Face::XMin)].inflow     = true;
+	SolverSettings settings;
+	settings.gravity = Vec3(0, 0, -g);
+	TwoPhaseSolver solver(d, settings);
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	double initial = 0;
+	for (double m : fluid.mass) initial += m;
+	const std::size_t before = fluid.size();
+	const double      dt     = 0.5 * solver.timeStepLimits().critical;
+	for (int i = 0; i < steps; ++i) solver.step(dt);
+	DryRows r;
+	r.pointMass = fluid.mass[0];
+	for (std::size_t p = before; p < fluid.size(); ++p) {
+		if (fluid.halfLength[p].x() < 0.5 * s * (1 - 1e-9) || fluid.position[p].x() > s) continue; // buffers, or not on the first spacing
+		++r.newPoints;
+		r.aboveLevel += fluid.position[p].z() > level;
+		r.inRow4 += fluid.position[p].z() > 4 * s && fluid.position[p].z() < 5 * s;
+	}
+	double stored = 0;
+	for (double m : fluid.mass) stored += m;
+	r.injected = solver.injectedWaterMass();
+	r.balance  = (stored + solver.removedWaterMass() - initial - r.injected) / initial;
+	return r;
+}
+
+TEST(InflowFace, WetsItsDryRowsBelowTheWaterTableOnce)
+{
+	const DryRows six = runDryRows(false, 6), twelve = runDryRows(false, 12);
+	std::printf("dry rows: %zu new points after 6 steps (%zu above the level), %zu after 12; injected %.3e kg (point %.3e kg); balance %.1e\n",
+	            six.newPoints, six.aboveLevel, twelve.newPoints, six.injected, six.pointMass, six.balance);
+	EXPECT_EQ(six.newPoints, 4u);
+	EXPECT_EQ(six.aboveLevel, 0u);
+	EXPECT_EQ(twelve.newPoints, 4u);
+	EXPECT_GE(six.injected, 4 * six.pointMass * (1 - 1e-12));
+	EXPECT_NEAR(six.balance, 0, 1e-12);
+	const DryRows drifted = runDryRows(true, 6);
+	std::printf("drifted rows: %zu new points, %zu in row 4 (covered 0.6 by its neighbours)\n", drifted.newPoints, drifted.inRow4);
+	EXPECT_EQ(drifted.inRow4, 0u);
+	EXPECT_EQ(drifted.newPoints, 0u);
+}
+
+} // namespace
