@@ -1,0 +1,192 @@
+// Seepage through the sand pile under a constant head at its crest, semi-implicit step (issue 14):
+// the pore pressure against a steady Darcy/Laplace solution of the same geometry computed here,
+// independently, by finite differences.
+//
+// The pile is the default of yade_mpm.sandpile.SandPileScene (0.12 m high, crest 0.10 m long from
+// the inflow face at x = 0, downstream slope 30°, k = 1e-3 m/s, n = 0.4, E = 20 MPa) in a slice one
+// cell thick, with an elastic skeleton (this test is about the seepage; the failure is issue 15's),
+// real water (Kw = 2.2 GPa) and FLIP. The inflow face holds the reservoir at the crest's height,
+// H = 0.12 m (eq. 2.1), and supplies the water that enters as new points (eq. 2.5); the base is
+// impermeable; the pile's own surface is at p = 0 (eq. 2.3). The pressure settles on the
+// consolidation time L²/c_v ≈ 0.3²/2.8 ≈ 0.03 s (c_v = k E_oed/γw).
+//
+// Reference: h(x, z) with ∇²h = 0 in the pile, h = H on the inflow face, ∂h/∂z = 0 on the base and
+// h = z (p = 0) on the surface, solved by SOR on a 2.5 mm grid. Its own discretisation error (the
+// staircase surface) shows in its discharge through the inflow face: 1.445, 1.395, 1.370e-5 m²/s
+// at 5, 2.5, 1.25 mm (measured).
+//
+// Measured (h = 1 cm, 2026-11-22): max |p − p_FD| = 0.068 γw H (mean 0.015), largest on the slope
+// next to its surface; at h = 2 cm 0.13 (the surface cells' share falls with h). The discharge the
+// inflow face supplies as points: 1.286e-5 m²/s at 0.1–0.2 s, 7.8% below the reference's 1.395e-5
+// (−19% at h = 2 cm: first order in h).
+//
+// Not checked here, and why: the issue also asks that water points cross the pile's surface and
+// that inflow = outflow over 1 s. At k = 1e-3 m/s the seepage velocity k i/n is about 1 mm/s, so in
+// 1 s no water point (2.5 mm apart at h = 1 cm) can leave through the slope, and the pile's surface,
+// held at p = 0 with no capillary suction, draws water in at the crest (where the head inside falls
+// below H) as well as letting it out on the slope: the flux through a section is not the inflow
+// until the phreatic surface has dropped, which takes tens of seconds (doc/theory.md §8, Open).
+#include "core/TwoPhaseSolver.hpp"
+#include "support/Fixtures.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+namespace {
+
+using namespace mpm;
+
+struct Pile {
+	double height = 0.12, crest = 0.10, slope = M_PI / 6; // [m], [m], [rad]
+	double surface(double x) const { return x <= crest ? height : std::max(0.0, height - (x - crest) * std::tan(slope)); }
+	double toe() const { return crest + height / std::tan(slope); }
+};
+
+// The steady head in the pile by successive over-relaxation: h = H at x = 0, h = z at and above
+// the surface, mirror at the impermeable base. Returns the head sampled at (x, z) by bilinear
+// interpolation, and the discharge through the inflow face per unit width [m² s⁻¹].
+struct LaplaceHead {
+	double              dx, H;
+	int                 nx, nz;
+	std::vector<double> head;
+	std::vector<char>   free;
+
+	LaplaceHead(const Pile& pile, double length, double spacing) : dx(spacing), H(pile.height)
+	{
+		nx = static_cast<int>(std::lround(length / dx));
+		nz = static_cast<int>(std::lround(pile.height / dx));
+		head.assign(static_cast<std::size_t>((nx + 1) * (nz + 1)), H);
+		free.assign(head.size(), 0);
+		for (int j = 0; j <= nz; ++j)
+			for (int i = 0; i <= nx; ++i) {
+				const double x = i * dx, z = j * dx;
+				// nodes within one spacing of the surface, and above it, carry p = 0
+				if (i == 0) head[id(i, j)] = H;
+				else if (z > pile.surface(x) - dx * 0.999 || pile.surface(x) <= 0) head[id(i, j)] = z;
+				else free[id(i, j)] = 1;
+			}
+		const double omega = 2 / (1 + std::sin(M_PI / nx)); // optimal for the longest side
+		for (int sweep = 0; sweep < 100000; ++sweep) {
+			double change = 0;
+			for (int j = 0; j <= nz; ++j)
+				for (int i = 1; i < nx; ++i) {
+					if (!free[id(i, j)]) continue;
+					const double below = j > 0 ? head[id(i, j - 1)] : head[id(i, j + 1)];
+					const double mean  = 0.25 * (head[id(i - 1, j)] + head[id(i + 1, j)] + head[id(i, j + 1)] + below);
+					const double next  = head[id(i, j)] + omega * (mean - head[id(i, j)]);
+					change             = std::max(change, std::abs(next - head[id(i, j)]));
+					head[id(i, j)]     = next;
+				}
+			if (change < 1e-12) break;
+		}
+	}
+	std::size_t id(int i, int j) const { return static_cast<std::size_t>(j * (nx + 1) + i); }
+	double      at(double x, double z) const
+	{
+		const double fi = x / dx, fj = z / dx;
+		const int    i = std::clamp(static_cast<int>(fi), 0, nx - 1), j = std::clamp(static_cast<int>(fj), 0, nz - 1);
+		const double a = fi - i, b = fj - j;
+		return (1 - a) * (1 - b) * head[id(i, j)] + a * (1 - b) * head[id(i + 1, j)] + (1 - a) * b * head[id(i, j + 1)] + a * b * head[id(i + 1, j + 1)];
+	}
+	double inflowDischarge(double k) const
+	{
+		double q = 0;
+		for (int j = 0; j < nz; ++j) q += k * (head[id(0, j)] - head[id(1, j)]) * (j == 0 ? 0.5 : 1.0); // (Δh/dx) dz with dz = dx
+		return q;
+	}
+};
+
+TEST(PileSeepage, PressureUnderAConstantHeadAtTheCrestIsTheLaplaceSolution)
+{
+	const double    g = 9.81, length = 0.6, k = 1e-3, h = 0.01;
+	const Pile      pile;
+	SoilParameters  soil;
+	WaterParameters water;
+	soil.youngModulus          = 20e6;
+	soil.porosity              = 0.4;
+	water.bulkModulus          = 2.2e9;
+	soil.intrinsicPermeability = k * water.viscosity / (water.density * g);
+	const double H = pile.height, gammaW = water.density * g, k0 = soil.poissonRatio / (1 - soil.poissonRatio);
+
+	const auto        all = fixtures::lattice(Vec3::Zero(), Vec3(length, h, H), h, 2);
+	fixtures::Lattice inPile;
+	inPile.spacing = all.spacing;
+	for (const Vec3& x : all.positions)
+		if (x.z() < pile.surface(x.x())) inPile.positions.push_back(x);
+	SolidPointSet solid = fixtures::solidLattice(inPile, soil.porosity, soil.density);
+	WaterPointSet fluid = fixtures::waterLattice(inPile, soil.porosity, water.density);
+	// start hydrostatic under the local surface, buoyant geostatic stress
+	for (std::size_t p = 0; p < solid.size(); ++p) {
+		const Vec3   x  = solid.position[p];
+		const double sz = -(1 - soil.porosity) * (soil.density - water.density) * g * (pile.surface(x.x()) - x.z());
+		solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
+		fluid.porePressure[p] = gammaW * (pile.surface(x.x()) - x.z());
+	}
+	Domain d = fixtures::columnDomain(Vec3(length, h, 0.2), h);
+	d.boundaries.walls[static_cast<int>(Face::ZMin)]            = { SolidWall::Fixed, WaterWall::Impermeable };
+	d.boundaries.walls[static_cast<int>(Face::ZMax)]            = { SolidWall::Free, WaterWall::Free };
+	d.boundaries.walls[static_cast<int>(Face::XMin)]            = { SolidWall::Slip, WaterWall::Drained, 0.0 };
+	d.boundaries.walls[static_cast<int>(Face::XMin)].waterTable = H;
+	d.boundaries.walls[static_cast<int>(Face::XMin)].inflow     = true;
+	d.boundaries.walls[static_cast<int>(Face::XMax)]            = { SolidWall::Slip, WaterWall::Free };
+	SolverSettings s;
+	s.gravity = Vec3(0, 0, -g);
+	s.scheme  = TimeScheme::SemiImplicit;
+	TwoPhaseSolver solver(d, s);
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	double initial = 0;
+	for (double m : fluid.mass) initial += m;
+	const std::size_t initialPoints = fluid.size();
+
+	// the toe's pore pressure: water points within 6 cm upstream of the toe and 3 cm of the base
+	auto toePressure = [&] {
+		std::vector<double> p;
+		for (std::size_t i = 0; i < fluid.size(); ++i)
+			if (fluid.position[i].x() > pile.toe() - 0.06 && fluid.position[i].z() < 0.03 && fluid.position[i].z() < pile.surface(fluid.position[i].x()))
+				p.push_back(fluid.porePressure[i]);
+		return p;
+	};
+	solver.advance(0.1); // ≈ 3 consolidation times
+	const std::vector<double> toeBefore = toePressure();
+	const double              injected0 = solver.injectedWaterMass(), window = 0.1;
+	solver.advance(window);
+	const std::vector<double> toeAfter = toePressure();
+	const double              supplied = (solver.injectedWaterMass() - injected0) / (water.density * h * window); // [m² s⁻¹]
+
+	const LaplaceHead reference(pile, length, 0.0025);
+	double            worst = 0, mean = 0;
+	int               count = 0;
+	for (std::size_t p = 0; p < fluid.size(); ++p) {
+		const Vec3 x = fluid.position[p];
+		if (x.z() >= pile.surface(x.x())) continue; // water that has left the soil
+		const double error = std::abs(fluid.porePressure[p] - gammaW * (reference.at(x.x(), x.z()) - x.z())) / (gammaW * H);
+		worst = std::max(worst, error);
+		mean += error;
+		++count;
+	}
+	double toeRate = 0;
+	ASSERT_EQ(toeBefore.size(), toeAfter.size()); // no point entered or left the toe region
+	ASSERT_FALSE(toeBefore.empty());
+	for (std::size_t i = 0; i < toeBefore.size(); ++i) toeRate = std::max(toeRate, std::abs(toeAfter[i] - toeBefore[i]) / window);
+	double stored = 0;
+	for (double m : fluid.mass) stored += m;
+	const double qReference = reference.inflowDischarge(k);
+	std::printf("pile seepage: max |p − p_FD| %.3f γw H (mean %.4f over %d points); toe |dp/dt| max %.1f Pa/s; inflow %.4e m²/s against %.4e (FD)\n", worst,
+	            mean / count, count, toeRate, supplied, qReference);
+	// the pressure field is the steady seepage's, within 10% of γw H (the issue's bound)
+	EXPECT_LT(worst, 0.10);
+	// the toe has settled: its pore pressure changes by less than 1 kPa/s
+	EXPECT_LT(toeRate, 1000.0);
+	// the water that enters through the face, as new points, carries the steady discharge within the
+	// first-order error of h = 1 cm (−7.8%, measured) and the reference's own (+2–4%)
+	EXPECT_GT(fluid.size(), initialPoints);
+	EXPECT_NEAR(supplied, qReference, 0.12 * qReference);
+	// each phase's mass: the water's to round-off with what came in
+	EXPECT_NEAR(stored, initial + solver.injectedWaterMass() - solver.removedWaterMass(), 1e-12 * initial);
+}
+
+} // namespace
