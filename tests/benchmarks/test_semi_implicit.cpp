@@ -487,7 +487,7 @@ TEST_P(DilatingElement, SuctionNextToADrainedFaceDecaysOnItsDrainageTime)
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, DilatingElement, ::testing::Values(TimeScheme::Explicit, TimeScheme::SemiImplicit),
-                         [](const ::testing::TestParamInfo<TimeScheme>& info) { return std::string(fixtures::schemeName(info.param)); });
+                         [](const ::testing::TestParamInfo<TimeScheme>& instance) { return std::string(fixtures::schemeName(instance.param)); });
 
 // A saturated column at rest under gravity whose top is an impermeable face over a free skeleton
 // (an undrained top, e.g. a sealed specimen): hydrostatic and at rest, whatever the scheme. The
@@ -539,4 +539,4 @@ TEST_P(ImpermeableTop, SaturatedColumnStaysAtRest)
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, ImpermeableTop, ::testing::Values(TimeScheme::Explicit, TimeScheme::SemiImplicit),
-                         [](const ::testing::TestParamInfo<TimeScheme>& info) { return std::string(fixtures::schemeName(info.param)); });
+                         [](const ::testing::TestParamInfo<TimeScheme>& instance) { return std::string(fixtures::schemeName(instance.param)); });

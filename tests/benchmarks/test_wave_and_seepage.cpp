@@ -453,7 +453,7 @@ TEST_P(Inflow, SuppliesTheDarcyFluxAndClosesTheWaterMassBalance)
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, Inflow, ::testing::Values(TimeScheme::Explicit, TimeScheme::SemiImplicit),
-                         [](const ::testing::TestParamInfo<TimeScheme>& info) { return info.param == TimeScheme::Explicit ? "Explicit" : "SemiImplicit"; });
+                         [](const ::testing::TestParamInfo<TimeScheme>& instance) { return instance.param == TimeScheme::Explicit ? "Explicit" : "SemiImplicit"; });
 
 } // namespace
 
@@ -560,7 +560,7 @@ TEST_P(LateralSeepage, InflowAndOutflowCarryTheDarcyDischarge)
 }
 
 INSTANTIATE_TEST_SUITE_P(Blends, LateralSeepage, ::testing::Values(0.0, 1.0),
-                         [](const ::testing::TestParamInfo<double>& info) { return info.param == 0 ? "PIC" : "FLIP"; });
+                         [](const ::testing::TestParamInfo<double>& instance) { return instance.param == 0 ? "PIC" : "FLIP"; });
 
 } // namespace
 
