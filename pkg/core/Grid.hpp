@@ -34,6 +34,12 @@ struct GridGeometry {
 	static GridGeometry forDomain(const Vec3& lower, const Vec3& upper, Real cellSize, const std::array<bool, 3>& periodic = { false, false, false });
 	std::size_t         nodeCount() const { return static_cast<std::size_t>(nodes[0]) * nodes[1] * nodes[2]; }
 	std::size_t         index(int i, int j, int k) const { return static_cast<std::size_t>(i) + nodes[0] * (static_cast<std::size_t>(j) + static_cast<std::size_t>(nodes[1]) * k); }
+	// grid indices (i, j, k) of node I
+	std::array<int, 3>  indices(std::size_t I) const
+	{
+		const std::size_t nx = nodes[0], ny = nodes[1];
+		return { static_cast<int>(I % nx), static_cast<int>((I / nx) % ny), static_cast<int>(I / (nx * ny)) };
+	}
 	Vec3                nodePosition(int i, int j, int k) const { return origin + cellSize * Vec3(i, j, k); }
 	Vec3                lower() const { return nodePosition(wallNode[0], wallNode[1], wallNode[2]); }
 	// Node index i along axis d after wrapping a periodic axis onto [wallNode, upperWallNode)

@@ -16,13 +16,6 @@ namespace {
 	using namespace detail;
 	constexpr Real notDrained = std::numeric_limits<Real>::quiet_NaN();
 
-	// Grid indices (i, j, k) of node I.
-	inline std::array<int, 3> nodeIndices(const GridGeometry& g, std::size_t I)
-	{
-		const std::size_t nx = g.nodes[0], ny = g.nodes[1];
-		return { static_cast<int>(I % nx), static_cast<int>((I / nx) % ny), static_cast<int>(I / (nx * ny)) };
-	}
-
 	// Stencil slot of the offset (a, b, c) ∈ [−2, 2]³ between two nodes sharing a point.
 	inline int offsetSlot(int a, int b, int c) { return (a + 2) + 5 * ((b + 2) + 5 * (c + 2)); }
 } // namespace
@@ -61,7 +54,7 @@ namespace stages {
 		system.fixedValue.assign(active, 0);
 		for (std::size_t r = 0; r < active; ++r) {
 			const std::size_t        I   = system.node[r];
-			const std::array<int, 3> idx = nodeIndices(grid, I);
+			const std::array<int, 3> idx = grid.indices(I);
 			// wall planes and the padding beyond them: a drained face prescribes p̄(t^{n+1}), a free
 			// water face p = 0 (its natural condition, which the compact operator L does not carry)
 			bool open = false, drained = false;
@@ -286,7 +279,7 @@ namespace stages {
 		using Entries = std::array<Entry, PressureSystem::offsets>;
 		auto collect = [&](std::size_t r, Entries& entries, Real& rhs) {
 			const Real*              k   = system.rows.data() + r * PressureSystem::rowStride;
-			const std::array<int, 3> idx = nodeIndices(grid, system.node[r]);
+			const std::array<int, 3> idx = grid.indices(system.node[r]);
 			int                      used = 0;
 			rhs                          = k[PressureSystem::rhsSlot];
 			for (int o = 0; o < PressureSystem::offsets; ++o) {

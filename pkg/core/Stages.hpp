@@ -100,6 +100,9 @@ namespace stages {
 
 	// Nodal porosity n_I = 1 − Σ S m/ρs / Σ S V (theory.md eq. 4.4); 1 where there is no solid.
 	void computeNodalPorosity(GridFields& fields);
+	// eq. 4.7b: the drag acts where the water is: Q_I scaled by the share V^w_I/V_I ≤ 1 of the
+	// skeleton's support that the water points fill (a node at a phreatic surface; not on a drained face)
+	void limitDragToWetSupport(const GridGeometry& grid, const BoundaryConditions& bcs, GridFields& fields);
 
 	// Steps 3–4 (theory.md eqs. 4.5–4.7): porosity at water points from the nodal field, then water
 	// mass, momentum, weight, −n∇p force (incl. the porosity-gradient term) and the pressure force.

@@ -78,6 +78,26 @@ namespace stages {
 		}
 	}
 
+	void limitDragToWetSupport(const GridGeometry& grid, const BoundaryConditions& bcs, GridFields& fields)
+	{
+		const std::size_t nodes = fields.solid.size();
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
+		for (std::size_t i = 0; i < nodes; ++i) {
+			const Real V = fields.solid[i].volume, Vw = fields.water[i].volume;
+			if (!(V > 0) || Vw >= V) continue;
+			// a drained face saturates the soil on its plane (p̄ ≥ 0); its water points are cut as
+			// they cross it (eq. 2.4), so there they sample the water only in part
+			const std::array<int, 3> idx = grid.indices(i);
+			bool onDrainedFace = false;
+			for (int axis = 0; axis < 3 && !onDrainedFace; ++axis) {
+				if (grid.periodic[axis]) continue;
+				onDrainedFace = (idx[axis] <= grid.wallNode[axis] + 1 && bcs.walls[2 * axis].water == WaterWall::Drained) ||
+				                (idx[axis] >= grid.upperWallNode[axis] - 1 && bcs.walls[2 * axis + 1].water == WaterWall::Drained);
+			}
+			if (!onDrainedFace) fields.solid[i].drag *= Vw / V;
+		}
+	}
+
 	template <class Kernel>
 	void mapWaterToGrid(const GridGeometry& grid, std::vector<WaterPointSet*>& sets, const Vec3& gravity, GridFields& fields, ScatterWorkspace& workspace,
 	                    bool pressureForces)

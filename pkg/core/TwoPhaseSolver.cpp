@@ -352,6 +352,7 @@ template <class Kernel> void TwoPhaseSolver::mapPointsToGrid(bool wet)
 	StageTimer t(stageSeconds_, Stage::MapWaterToGrid);
 	const bool explicitScheme = settings_.scheme == TimeScheme::Explicit;
 	mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_, explicitScheme);
+	limitDragToWetSupport(grid_, domain_.boundaries, fields_); // eq. 4.7b
 	// semi-implicit: these are pore-pressure forces too, applied with the others in the corrector
 	if (explicitScheme) addDrainedFaceTractions(grid_, domain_.boundaries, g, water_.density, waterMassTolerance_, fields_);
 }
