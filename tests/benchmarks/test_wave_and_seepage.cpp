@@ -737,3 +737,73 @@ INSTANTIATE_TEST_SUITE_P(Schemes, PhreaticSurfaceDrag, ::testing::Values(TimeSch
                          [](const ::testing::TestParamInfo<TimeScheme>& instance) { return std::string(fixtures::schemeName(instance.param)); });
 
 } // namespace
+
+namespace {
+
+// Charny's rectangular dam (unconfined steady seepage with a seepage face; issue 14): soil L = 0.4 m
+// long and 0.35 m high between an inflow face at x = 0 under H1 = 0.3 m of water and a drained face
+// at x = L under H2 = 0.1 m (p̄ = 0 above H2: the seepage face), impermeable base, k = 0.01 m/s,
+// real water, semi-implicit, FLIP, h = 2.5 cm, a loose skeleton (E = 1 MPa: the steady discharge does
+// not depend on it, and the step, which follows the skeleton's wave, is 3.2 times that of 10 MPa).
+// Charny's exact discharge (for any free surface shape): q = k (H1² − H2²)/(2L) = 1.0e-3 m²/s.
+// Started under Dupuit's parabola (the true surface lies above it near the seepage face), it settles
+// on the storage time L² n/(k H) ≈ 3 s; measured over 10–13 s, both from the water points that enter
+// (eq. 2.5) and from those that leave (eq. 2.4). Measured (windows of 1 s from 9 to 14 s): in
+// 1.00, 1.00, 1.00, 0.98, 0.89e-3, out 1.02, 0.99, 1.00, 1.02, 1.02e-3 m²/s; with E = 10 MPa over
+// 10–14 s in −0.02%, out −1.40% (350 s of CPU). This test over 10–13 s: in −0.58%, out +0.29%. Before the drag acted only where the water is (eq. 4.7b) the outflow stayed 10% low; before a
+// drifted point counted for its rows (eq. 2.5) the face's column packed 1.2–1.6× with water and FLIP
+// threw a point out through it at 11.5 s. At k = 0.1 m/s (τ/Δt ≈ 180) the same dam still fails:
+// PIC's viscosity and a drift of the water points' density (theory.md §8, Open).
+TEST(Charny, RectangularDamCarriesCharnysDischargeInAndOut)
+{
+	const double    g = 9.81, L = 0.4, soilHeight = 0.35, H1 = 0.3, H2 = 0.1, h = 0.025, k = 0.01;
+	SoilParameters  soil;
+	WaterParameters water;
+	soil.porosity              = 0.4;
+	soil.youngModulus          = 1e6;
+	soil.intrinsicPermeability = k * water.viscosity / (water.density * g);
+	const auto l        = fixtures::lattice(Vec3::Zero(), Vec3(L, h, soilHeight), h, 2);
+	auto       dupuit   = [&](double x) { return std::sqrt(H1 * H1 - (H1 * H1 - H2 * H2) * x / L); };
+	SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
+	fixtures::Lattice wet;
+	wet.spacing = l.spacing;
+	for (const Vec3& x : l.positions)
+		if (x.z() < dupuit(x.x())) wet.positions.push_back(x);
+	WaterPointSet fluid  = fixtures::waterLattice(wet, soil.porosity, water.density);
+	const double  gammaW = water.density * g, k0 = soil.poissonRatio / (1 - soil.poissonRatio);
+	for (std::size_t p = 0; p < solid.size(); ++p) { // dry above the surface, buoyant below
+		const Vec3   x  = solid.position[p];
+		const double sz = -(1 - soil.porosity) * soil.density * g * (soilHeight - x.z()) + gammaW * std::max(0.0, dupuit(x.x()) - x.z());
+		solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
+	}
+	for (std::size_t p = 0; p < fluid.size(); ++p) fluid.porePressure[p] = gammaW * (dupuit(fluid.position[p].x()) - fluid.position[p].z());
+	Domain d = fixtures::columnDomain(Vec3(L, h, 0.4), h);
+	d.boundaries.walls[static_cast<int>(Face::ZMax)]            = { SolidWall::Free, WaterWall::Drained, 0.0 };
+	d.boundaries.walls[static_cast<int>(Face::XMin)]            = { SolidWall::Slip, WaterWall::Drained, 0.0 };
+	d.boundaries.walls[static_cast<int>(Face::XMin)].waterTable = H1;
+	d.boundaries.walls[static_cast<int>(Face::XMin)].inflow     = true;
+	d.boundaries.walls[static_cast<int>(Face::XMax)]            = { SolidWall::Slip, WaterWall::Drained, 0.0 };
+	d.boundaries.walls[static_cast<int>(Face::XMax)].waterTable = H2;
+	SolverSettings s;
+	s.gravity = Vec3(0, 0, -g);
+	s.scheme  = TimeScheme::SemiImplicit;
+	TwoPhaseSolver solver(d, s);
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	double initial = 0;
+	for (double m : fluid.mass) initial += m;
+	solver.advance(10.0);
+	const double injected0 = solver.injectedWaterMass(), removed0 = solver.removedWaterMass(), window = 3.0;
+	solver.advance(window);
+	const double toDischarge = 1 / (water.density * h * window); // kg over the window → m² s⁻¹
+	const double qIn = (solver.injectedWaterMass() - injected0) * toDischarge, qOut = (solver.removedWaterMass() - removed0) * toDischarge;
+	const double charny = k * (H1 * H1 - H2 * H2) / (2 * L);
+	double       stored = 0;
+	for (double m : fluid.mass) stored += m;
+	std::printf("Charny's dam: q in %.5e, out %.5e m²/s (%+.2f%%, %+.2f%% of Charny's %.5e)\n", qIn, qOut, 100 * (qIn / charny - 1), 100 * (qOut / charny - 1), charny);
+	EXPECT_NEAR(qIn, charny, 0.02 * charny);
+	EXPECT_NEAR(qOut, charny, 0.02 * charny);
+	EXPECT_NEAR(qIn, qOut, 0.01 * charny); // steady: what enters leaves
+	EXPECT_NEAR(stored + solver.removedWaterMass(), initial + solver.injectedWaterMass(), 1e-12 * initial);
+}
+
+} // namespace
