@@ -649,22 +649,15 @@ void TwoPhaseSolver::injectInflowingWater()
 				const long r1 = static_cast<long>(std::floor((x[a1] - lower[a1]) / spacing[a1]));
 				const long r2 = static_cast<long>(std::floor((x[a2] - lower[a2]) / spacing[a2]));
 				if (r1 < 0 || r1 >= rows1 || r2 < 0 || r2 >= rows2) continue;
+				const long row = r1 * rows2 + r2;
 				if (w->halfLength[p][axis] < (1 - inflowBufferTolerance) * halfLength[axis]) {
-					inflowBuffer_[r1 * rows2 + r2] = static_cast<long>(p);
+					inflowBuffer_[row] = static_cast<long>(p);
 					continue;
 				}
-				// a regular point is the outermost of every row whose patch its domain covers at least
-				// half of: one that has drifted half a spacing along the face still fills that row's gap
-				for (long q1 = std::max<long>(0, r1 - 1); q1 <= std::min<long>(rows1 - 1, r1 + 1); ++q1)
-					for (long q2 = std::max<long>(0, r2 - 1); q2 <= std::min<long>(rows2 - 1, r2 + 1); ++q2) {
-						const Real o1 = std::min(x[a1] + l[a1], lower[a1] + (q1 + 1) * spacing[a1]) - std::max(x[a1] - l[a1], lower[a1] + q1 * spacing[a1]);
-						const Real o2 = std::min(x[a2] + l[a2], lower[a2] + (q2 + 1) * spacing[a2]) - std::max(x[a2] - l[a2], lower[a2] + q2 * spacing[a2]);
-						const long row = q1 * rows2 + q2;
-						if (o1 >= 0.5 * spacing[a1] && o2 >= 0.5 * spacing[a2] && depth < inflowDepth_[row]) {
-							inflowDepth_[row]   = depth;
-							inflowNearest_[row] = static_cast<long>(p);
-						}
-					}
+				if (depth < inflowDepth_[row]) {
+					inflowDepth_[row]   = depth;
+					inflowNearest_[row] = static_cast<long>(p);
+				}
 			}
 			removeFlags_.assign(w->size(), 0);
 			bool anyRemoved = false;
