@@ -50,8 +50,7 @@ NodeConstraint constraintAt(const GridGeometry& grid, const BoundaryConditions& 
 	for (int axis = 0; axis < 3; ++axis) {
 		if (grid.periodic[axis]) continue; // no wall across a periodic axis
 		for (int side = 0; side < 2; ++side) {
-			const bool onOrBeyond = side == 0 ? idx[axis] <= grid.wallNode[axis] : idx[axis] >= grid.upperWallNode[axis];
-			if (!onOrBeyond) continue;
+			if (!grid.atWall(axis, side, idx[axis])) continue;
 			const WallConditions& wall = bcs.walls[2 * axis + side];
 			if (wall.solid == SolidWall::Fixed) {
 				c.solid     = { true, true, true };

@@ -40,6 +40,12 @@ struct GridGeometry {
 		const std::size_t nx = nodes[0], ny = nodes[1];
 		return { static_cast<int>(I % nx), static_cast<int>((I / nx) % ny), static_cast<int>(I / (nx * ny)) };
 	}
+	// whether node index i along axis d lies on the wall plane of `side` (0 lower, 1 upper), beyond it,
+	// or within `inward` nodes inside it; a periodic axis has no walls
+	bool                atWall(int d, int side, int i, int inward = 0) const
+	{
+		return !periodic[d] && (side == 0 ? i <= wallNode[d] + inward : i >= upperWallNode[d] - inward);
+	}
 	Vec3                nodePosition(int i, int j, int k) const { return origin + cellSize * Vec3(i, j, k); }
 	Vec3                lower() const { return nodePosition(wallNode[0], wallNode[1], wallNode[2]); }
 	// Node index i along axis d after wrapping a periodic axis onto [wallNode, upperWallNode)

@@ -89,11 +89,8 @@ namespace stages {
 			// they cross it (eq. 2.4), so there they sample the water only in part
 			const std::array<int, 3> idx = grid.indices(i);
 			bool onDrainedFace = false;
-			for (int axis = 0; axis < 3 && !onDrainedFace; ++axis) {
-				if (grid.periodic[axis]) continue;
-				onDrainedFace = (idx[axis] <= grid.wallNode[axis] + 1 && bcs.walls[2 * axis].water == WaterWall::Drained) ||
-				                (idx[axis] >= grid.upperWallNode[axis] - 1 && bcs.walls[2 * axis + 1].water == WaterWall::Drained);
-			}
+			for (int face = 0; face < 6 && !onDrainedFace; ++face)
+				onDrainedFace = bcs.walls[face].water == WaterWall::Drained && grid.atWall(face / 2, face % 2, idx[face / 2], 1);
 			if (!onDrainedFace) fields.solid[i].drag *= Vw / V;
 		}
 	}
