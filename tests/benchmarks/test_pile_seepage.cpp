@@ -113,10 +113,7 @@ TEST(PileSeepage, PressureUnderAConstantHeadAtTheCrestIsTheLaplaceSolution)
 	const double H = pile.height, gammaW = water.density * g, k0 = soil.poissonRatio / (1 - soil.poissonRatio);
 
 	const auto        all = fixtures::lattice(Vec3::Zero(), Vec3(length, h, H), h, 2);
-	fixtures::Lattice inPile;
-	inPile.spacing = all.spacing;
-	for (const Vec3& x : all.positions)
-		if (x.z() < pile.surface(x.x())) inPile.positions.push_back(x);
+	const auto inPile = fixtures::latticeWhere(all, [&](const Vec3& x) { return x.z() < pile.surface(x.x()); });
 	SolidPointSet solid = fixtures::solidLattice(inPile, soil.porosity, soil.density);
 	WaterPointSet fluid = fixtures::waterLattice(inPile, soil.porosity, water.density);
 	// start hydrostatic under the local surface, buoyant geostatic stress
@@ -129,9 +126,7 @@ TEST(PileSeepage, PressureUnderAConstantHeadAtTheCrestIsTheLaplaceSolution)
 	Domain d = fixtures::columnDomain(Vec3(length, h, 0.2), h);
 	d.boundaries.walls[static_cast<int>(Face::ZMin)]            = { SolidWall::Fixed, WaterWall::Impermeable };
 	d.boundaries.walls[static_cast<int>(Face::ZMax)]            = { SolidWall::Free, WaterWall::Free };
-	d.boundaries.walls[static_cast<int>(Face::XMin)]            = { SolidWall::Slip, WaterWall::Drained, 0.0 };
-	d.boundaries.walls[static_cast<int>(Face::XMin)].waterTable = H;
-	d.boundaries.walls[static_cast<int>(Face::XMin)].inflow     = true;
+	fixtures::reservoirFace(d, Face::XMin, H, true);
 	d.boundaries.walls[static_cast<int>(Face::XMax)]            = { SolidWall::Slip, WaterWall::Free };
 	SolverSettings s;
 	s.gravity = Vec3(0, 0, -g);

@@ -531,11 +531,8 @@ TEST_P(LateralSeepage, InflowAndOutflowCarryTheDarcyDischarge)
 	for (std::size_t p = 0; p < fluid.size(); ++p) fluid.porePressure[p] = gammaW * (head(fluid.position[p].x()) - fluid.position[p].z());
 	Domain d = fixtures::columnDomain(Vec3(L, h, D), h);
 	d.boundaries.walls[static_cast<int>(Face::ZMax)]        = { SolidWall::Slip, WaterWall::Impermeable };
-	d.boundaries.walls[static_cast<int>(Face::XMin)]        = { SolidWall::Slip, WaterWall::Drained, 0.0 };
-	d.boundaries.walls[static_cast<int>(Face::XMin)].waterTable = H1;
-	d.boundaries.walls[static_cast<int>(Face::XMin)].inflow = true;
-	d.boundaries.walls[static_cast<int>(Face::XMax)]        = { SolidWall::Slip, WaterWall::Drained, 0.0 };
-	d.boundaries.walls[static_cast<int>(Face::XMax)].waterTable = H2;
+	fixtures::reservoirFace(d, Face::XMin, H1, true);
+	fixtures::reservoirFace(d, Face::XMax, H2, false);
 	SolverSettings s;
 	s.gravity             = Vec3(0, 0, -g);
 	s.scheme              = TimeScheme::SemiImplicit;
@@ -658,6 +655,49 @@ TEST(InflowFace, WetsItsDryRowsBelowTheWaterTableOnce)
 	EXPECT_EQ(drifted.newPoints, 0u);
 }
 
+// A row's buffer sits on the row's axis (eq. 2.5): the water starts half a spacing in from an inflow
+// face (each row a gap of s/2 for its buffer) and the face column's point of row 3 has drifted 0.3 s
+// along the face, its centre still in its row. The buffers must tile the face, each on its row's axis
+// and none overlapping another: a buffer placed with the drifted point overlapped row 4's by 0.3 of
+// a row and sampled that water twice (Charny's dam: the face's cells packed 1.2–1.6× by 12 s).
+TEST(InflowFace, BuffersTileTheFaceWhenAPointHasDrifted)
+{
+	const double    g = 9.81, L = 0.2, W = 0.05, D = 0.2, h = 0.05, s = h / 2;
+	SoilParameters  soil;
+	WaterParameters water;
+	soil.intrinsicPermeability = 1e-5 * water.viscosity / (water.density * g); // the water hardly moves in one step
+	const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(L, W, D), h, 2);
+	SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
+	fixtures::Lattice shifted = fixtures::latticeWhere(l, [&](const Vec3& x) { return x.x() > s; });
+	for (Vec3& x : shifted.positions) {
+		x.x() -= 0.5 * s; // the first column now half a spacing from the face
+		if (x.x() < 1.5 * s && std::abs(x.z() - 3.5 * s) < 1e-9) x.z() += 0.3 * s;
+	}
+	WaterPointSet fluid = fixtures::waterLattice(shifted, soil.porosity, water.density);
+	fixtures::setGeostatic(solid, fluid, soil, water, g, D); // per point's own depth
+	Domain d = fixtures::columnDomain(Vec3(L, W, D), h);
+	fixtures::reservoirFace(d, Face::XMin, D, true);
+	SolverSettings settings;
+	settings.gravity = Vec3(0, 0, -g);
+	TwoPhaseSolver solver(d, settings);
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	solver.step(0.5 * solver.timeStepLimits().critical);
+	std::vector<Vec3> buffers;
+	for (std::size_t p = 0; p < fluid.size(); ++p)
+		if (fluid.halfLength[p].x() < 0.5 * s * (1 - 1e-9)) buffers.push_back(fluid.position[p]);
+	double offAxis = 0, overlap = 0;
+	for (std::size_t i = 0; i < buffers.size(); ++i) {
+		offAxis = std::max(offAxis, std::abs(buffers[i].z() / s - (std::floor(buffers[i].z() / s) + 0.5)) * s);
+		for (std::size_t j = 0; j < i; ++j)
+			if (std::abs(buffers[i].y() - buffers[j].y()) < s * (1 - 1e-9))
+				overlap = std::max(overlap, std::max(0.0, s - std::abs(buffers[i].z() - buffers[j].z())));
+	}
+	std::printf("inflow buffers: %zu, largest distance from a row axis %.2e m, largest overlap %.2e m (spacing %.3f m)\n", buffers.size(), offAxis, overlap, s);
+	EXPECT_EQ(buffers.size(), static_cast<std::size_t>(std::lround(W / s * D / s))); // one per row of the face
+	EXPECT_LT(offAxis, 1e-9);
+	EXPECT_LT(overlap, 1e-9);
+}
+
 } // namespace
 
 namespace {
@@ -680,10 +720,7 @@ TEST_P(PhreaticSurfaceDrag, WaterUpToTheSurfaceMovesAtDarcysVelocity)
 	soil.intrinsicPermeability = k * water.viscosity / (water.density * g);
 	const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(4 * h, h, soilHeight), h, 2);
 	SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
-	fixtures::Lattice wet;
-	wet.spacing = l.spacing;
-	for (const Vec3& x : l.positions)
-		if (x.z() < waterTable) wet.positions.push_back(x);
+	const auto    wet   = fixtures::latticeWhere(l, [&](const Vec3& x) { return x.z() < waterTable; });
 	WaterPointSet fluid  = fixtures::waterLattice(wet, soil.porosity, water.density);
 	const double  gammaW = water.density * g;
 	const double darcy   = soil.intrinsicPermeability * water.density * g * std::sin(beta) / water.viscosity;
@@ -751,7 +788,7 @@ namespace {
 // (eq. 2.5) and from those that leave (eq. 2.4). Measured (windows of 1 s from 9 to 14 s): in
 // 1.00, 1.00, 1.00, 0.98, 0.89e-3, out 1.02, 0.99, 1.00, 1.02, 1.02e-3 m²/s; with E = 10 MPa over
 // 10–14 s in −0.02%, out −1.40% (350 s of CPU). This test over 10–13 s: in −0.58%, out +0.29%. Before the drag acted only where the water is (eq. 4.7b) the outflow stayed 10% low; before a
-// drifted point counted for its rows (eq. 2.5) the face's column packed 1.2–1.6× with water and FLIP
+// buffer sat on its row's axis (eq. 2.5), not a drifted point's, the face's column packed 1.2–1.6× and FLIP
 // threw a point out through it at 11.5 s. At k = 0.1 m/s (τ/Δt ≈ 180) the same dam still fails:
 // PIC's viscosity and a drift of the water points' density (theory.md §8, Open).
 TEST(Charny, RectangularDamCarriesCharnysDischargeInAndOut)
@@ -765,10 +802,7 @@ TEST(Charny, RectangularDamCarriesCharnysDischargeInAndOut)
 	const auto l        = fixtures::lattice(Vec3::Zero(), Vec3(L, h, soilHeight), h, 2);
 	auto       dupuit   = [&](double x) { return std::sqrt(H1 * H1 - (H1 * H1 - H2 * H2) * x / L); };
 	SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
-	fixtures::Lattice wet;
-	wet.spacing = l.spacing;
-	for (const Vec3& x : l.positions)
-		if (x.z() < dupuit(x.x())) wet.positions.push_back(x);
+	const auto    wet   = fixtures::latticeWhere(l, [&](const Vec3& x) { return x.z() < dupuit(x.x()); });
 	WaterPointSet fluid  = fixtures::waterLattice(wet, soil.porosity, water.density);
 	const double  gammaW = water.density * g, k0 = soil.poissonRatio / (1 - soil.poissonRatio);
 	for (std::size_t p = 0; p < solid.size(); ++p) { // dry above the surface, buoyant below
@@ -779,11 +813,8 @@ TEST(Charny, RectangularDamCarriesCharnysDischargeInAndOut)
 	for (std::size_t p = 0; p < fluid.size(); ++p) fluid.porePressure[p] = gammaW * (dupuit(fluid.position[p].x()) - fluid.position[p].z());
 	Domain d = fixtures::columnDomain(Vec3(L, h, 0.4), h);
 	d.boundaries.walls[static_cast<int>(Face::ZMax)]            = { SolidWall::Free, WaterWall::Drained, 0.0 };
-	d.boundaries.walls[static_cast<int>(Face::XMin)]            = { SolidWall::Slip, WaterWall::Drained, 0.0 };
-	d.boundaries.walls[static_cast<int>(Face::XMin)].waterTable = H1;
-	d.boundaries.walls[static_cast<int>(Face::XMin)].inflow     = true;
-	d.boundaries.walls[static_cast<int>(Face::XMax)]            = { SolidWall::Slip, WaterWall::Drained, 0.0 };
-	d.boundaries.walls[static_cast<int>(Face::XMax)].waterTable = H2;
+	fixtures::reservoirFace(d, Face::XMin, H1, true);
+	fixtures::reservoirFace(d, Face::XMax, H2, false);
 	SolverSettings s;
 	s.gravity = Vec3(0, 0, -g);
 	s.scheme  = TimeScheme::SemiImplicit;

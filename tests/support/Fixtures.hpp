@@ -26,6 +26,16 @@ inline Lattice lattice(const Vec3& lower, const Vec3& upper, Real h, int perCell
 	return out;
 }
 
+// The points of l where keep(x) holds (a soil's shape, a water table), at l's spacing.
+template <class Keep> inline Lattice latticeWhere(const Lattice& l, Keep keep)
+{
+	Lattice out;
+	out.spacing = l.spacing;
+	for (const Vec3& x : l.positions)
+		if (keep(x)) out.positions.push_back(x);
+	return out;
+}
+
 inline SolidPointSet solidLattice(const Lattice& l, Real porosity, Real grainDensity)
 {
 	SolidPointSet s;
@@ -81,6 +91,16 @@ inline Domain columnDomain(const Vec3& size, Real cellSize)
 	d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
 	d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Drained };
 	return d;
+}
+
+// A drained face under a reservoir at level waterTable (p̄ hydrostatic below it, 0 above: a seepage
+// face), the skeleton held by `solid`; with inflow, the water it draws in enters as points (eq. 2.5).
+inline void reservoirFace(Domain& d, Face face, Real waterTable, bool inflow, SolidWall solid = SolidWall::Slip)
+{
+	WallConditions& wall = d.boundaries.walls[static_cast<int>(face)];
+	wall                 = { solid, WaterWall::Drained, 0.0 };
+	wall.waterTable      = waterTable;
+	wall.inflow          = inflow;
 }
 
 // The name a parameterised test gets for each scheme.
