@@ -1,0 +1,491 @@
+"""Limit-equilibrium slope stability (method of slices) on a 2D section, with the pore pressures of
+an MPM run: the check geotechnical engineers know, next to the MPM's own failure (doc/theory.md §9).
+
+* Bishop's simplified method (Bishop 1955): vertical equilibrium of each slice with horizontal
+  interslice forces and moment equilibrium of the sliding mass about the circle's centre; for a
+  surface that is not a circle (a circle clipped by a firm base) the same equations with the
+  general moment arms (the λ = 0 case of Fredlund & Krahn's GLE, 1977).
+* Spencer's method (Spencer 1967): force and moment equilibrium with parallel interslice forces of
+  unknown inclination θ, for any slip surface (circular or not).
+* `critical_circle`: a grid search over centres and radii for the smallest factor of safety.
+* `Strength.davis()`: the strength a non-associated Mohr–Coulomb material mobilises at collapse
+  (Davis 1968, as used by Sloan 2013 and Tschuchnigg et al. 2015): c* = β c, tan φ* = β tan φ,
+  β = cos ψ cos φ / (1 − sin ψ sin φ). β = 1 for ψ = φ (associated flow).
+* `infinite_slope_factor`: the closed form of a slope of constant inclination with a slip plane
+  parallel to its surface.
+* `section_from_points`: the section of an MPM run (weights from the points' masses, pore
+  pressures from the water points), averaged across the out-of-plane direction.
+
+Conventions: SI units; z up; pore pressure u compression-positive (the MPM's p), suction (u < 0)
+counts as it does in the MPM's effective stress. The section's slope descends towards +x when
+`direction` = +1 (the sand pile), towards −x when −1. Forces are per unit out-of-plane width.
+"""
+import math
+from dataclasses import dataclass, replace
+from typing import Callable, Optional
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Strength:
+    """Mohr–Coulomb strength on the slip surface: τ = c + σ′ tan φ."""
+    cohesion: float = 0.0          # c′ [Pa], ≥ 0
+    friction_angle: float = 0.0    # φ′ [rad], [0, π/2)
+    dilatancy_angle: Optional[float] = None  # ψ [rad], [0, φ′]; None: associated flow (ψ = φ′)
+
+    def validate(self):
+        if not self.cohesion >= 0:
+            raise ValueError("Strength.cohesion = %r Pa is outside the valid range [0, inf)" % self.cohesion)
+        if not 0 <= self.friction_angle < math.pi / 2:
+            raise ValueError("Strength.friction_angle = %r rad is outside the valid range [0, π/2)" % self.friction_angle)
+        if self.dilatancy_angle is not None and not 0 <= self.dilatancy_angle <= self.friction_angle:
+            raise ValueError("Strength.dilatancy_angle = %r rad is outside the valid range [0, friction_angle = %r]"
+                             % (self.dilatancy_angle, self.friction_angle))
+        if self.cohesion == 0 and self.friction_angle == 0:
+            raise ValueError("Strength has neither cohesion nor friction: every slope fails")
+        return self
+
+    def davis(self):
+        """The associated strength with the same collapse load as this non-associated one
+        (Davis 1968): c* = β c, tan φ* = β tan φ, β = cos ψ cos φ / (1 − sin ψ sin φ)."""
+        self.validate()
+        if self.dilatancy_angle is None:
+            return self
+        phi, psi = self.friction_angle, self.dilatancy_angle
+        beta = math.cos(psi) * math.cos(phi) / (1 - math.sin(psi) * math.sin(phi))
+        return Strength(cohesion=beta * self.cohesion, friction_angle=math.atan(beta * math.tan(phi)), dilatancy_angle=None)
+
+
+@dataclass(frozen=True)
+class Section:
+    """A 2D slope section.
+
+    surface_x, surface_z: the ground surface as a polyline, x increasing [m];
+    column_weight(x, z_base): weight of the column above z_base at x per unit area, ∫ γ dz [Pa];
+    pore_pressure(x, z): u [Pa] (compression-positive), vectorised over numpy arrays;
+    strength: the Strength used on the slip surface (apply .davis() before for non-associated flow);
+    direction: +1 where the slope descends towards +x, −1 towards −x;
+    base_z: a firm stratum the slip surface does not cross (None: no such stratum) [m].
+    """
+    surface_x: np.ndarray
+    surface_z: np.ndarray
+    column_weight: Callable
+    pore_pressure: Callable
+    strength: Strength
+    direction: int = 1
+    base_z: Optional[float] = None
+
+    def validate(self):
+        x = np.asarray(self.surface_x, dtype=float)
+        if x.ndim != 1 or x.size < 2 or np.asarray(self.surface_z).shape != x.shape:
+            raise ValueError("Section.surface_x and surface_z must be 1D arrays of the same length ≥ 2")
+        if not np.all(np.diff(x) > 0):
+            raise ValueError("Section.surface_x must increase strictly")
+        if self.direction not in (1, -1):
+            raise ValueError("Section.direction = %r is outside the valid values {+1, -1}" % self.direction)
+        self.strength.validate()
+        return self
+
+    def surface(self, x):
+        """Ground surface height z(x) [m]."""
+        return np.interp(x, self.surface_x, self.surface_z)
+
+
+def uniform_section(surface_x, surface_z, unit_weight, strength, pore_pressure=None, direction=1, base_z=None):
+    """A section of one material of unit weight γ [N m⁻³] (> 0); pore_pressure(x, z) [Pa] or None (dry)."""
+    if not unit_weight > 0:
+        raise ValueError("unit_weight = %r N/m³ is outside the valid range (0, inf)" % unit_weight)
+    surface_x = np.asarray(surface_x, dtype=float)
+    surface_z = np.asarray(surface_z, dtype=float)
+
+    def column_weight(x, z_base):
+        return unit_weight * np.clip(np.interp(x, surface_x, surface_z) - z_base, 0, None)
+
+    dry = lambda x, z: np.zeros(np.broadcast(x, z).shape)
+    return Section(surface_x, surface_z, column_weight, pore_pressure or dry, strength, direction, base_z).validate()
+
+
+@dataclass
+class Slices:
+    """The slices of one slip surface, in the frame where the mass slides towards +x (x mirrored
+    for a section with direction −1). Arrays of one value per slice."""
+    x: np.ndarray       # base midpoint x [m]
+    z: np.ndarray       # base midpoint z [m]
+    width: np.ndarray   # b [m]
+    alpha: np.ndarray   # base inclination, > 0 where the base descends towards +x [rad]
+    weight: np.ndarray  # W per unit width [N m⁻¹]
+    pore_pressure: np.ndarray  # u at the base midpoint [Pa]
+    cohesion: float
+    tan_friction: float
+    centre: Optional[tuple] = None  # moment centre (x, z) of a circle, in the same frame
+
+    @property
+    def base_length(self):
+        return self.width / np.cos(self.alpha)
+
+    def volume(self, section):
+        """Area of the sliding mass per unit width [m²]."""
+        return float(np.sum(self.width * (section_surface_mirrored(section, self.x) - self.z)))
+
+
+def section_surface_mirrored(section, x):
+    return section.surface(section.direction * x)
+
+
+def slices_of_surface(section, slip_x, slip_z, count=40):
+    """Slices of a slip surface given as a polyline (slip_x increasing, in the section's frame)
+    from its entry to its exit on the ground surface; count slices of equal width."""
+    section.validate()
+    slip_x = np.asarray(slip_x, dtype=float)
+    slip_z = np.asarray(slip_z, dtype=float)
+    edges = np.linspace(slip_x[0], slip_x[-1], count + 1)
+    return _build_slices(section, edges, lambda x: np.interp(x, slip_x, slip_z), None)
+
+
+def slices_of_circle(section, centre, radius, count=40, min_depth=0.0):
+    """Slices of the circle (centre (x, z) [m], radius [m]) where it runs below the ground surface
+    (clipped by section.base_z), or None where it does not cut a sliding mass deeper than
+    min_depth [m] or leaves the section's ends."""
+    xc, zc = centre
+    x_lo = max(xc - radius, section.surface_x[0])
+    x_hi = min(xc + radius, section.surface_x[-1])
+    if x_hi <= x_lo:
+        return None
+    x = np.linspace(x_lo, x_hi, 801)
+
+    def base(xq):
+        zb = zc - np.sqrt(np.clip(radius * radius - (xq - xc) ** 2, 0, None))
+        return zb if section.base_z is None else np.maximum(zb, section.base_z)
+
+    depth = section.surface(x) - base(x)
+    inside = depth > 0
+    if not inside.any():
+        return None
+    # the contiguous run that holds the deepest point is the sliding mass
+    deepest = int(np.argmax(depth))
+    lo = deepest
+    while lo > 0 and inside[lo - 1]:
+        lo -= 1
+    hi = deepest
+    while hi < x.size - 1 and inside[hi + 1]:
+        hi += 1
+    if depth[deepest] < min_depth:
+        return None
+    if lo == 0 or hi == x.size - 1:
+        # the lower arc ends under the ground (the circle's side, or the section's end): not a
+        # slip surface from ground to ground
+        return None
+    # entry and exit where the depth crosses zero (linear between samples)
+    x_in = x[lo - 1] + (x[lo] - x[lo - 1]) * (-depth[lo - 1]) / (depth[lo] - depth[lo - 1])
+    x_out = x[hi] + (x[hi + 1] - x[hi]) * depth[hi] / (depth[hi] - depth[hi + 1])
+    edges = np.linspace(x_in, x_out, count + 1)
+    return _build_slices(section, edges, base, (xc, zc))
+
+
+def _build_slices(section, edges, base, centre):
+    """Slices between edges (section frame) under the slip surface z = base(x); returned in the
+    frame sliding towards +x."""
+    mid = 0.5 * (edges[:-1] + edges[1:])
+    width = np.diff(edges)
+    z_mid = base(mid)
+    # weight by Simpson's rule over each slice (exact for a linear surface and a straight base)
+    w_lo = section.column_weight(edges[:-1], base(edges[:-1]))
+    w_hi = section.column_weight(edges[1:], base(edges[1:]))
+    w_mid = section.column_weight(mid, z_mid)
+    weight = width * (w_lo + 4 * w_mid + w_hi) / 6
+    slope = (base(edges[1:]) - base(edges[:-1])) / width
+    u = np.asarray(section.pore_pressure(mid, z_mid), dtype=float)
+    s = section.direction
+    strength = section.strength
+    if s == 1:
+        x_frame, alpha = mid, -np.arctan(slope)
+        c = centre
+    else:  # mirror x so that the mass slides towards +x
+        order = slice(None, None, -1)
+        x_frame, alpha = -mid[order], np.arctan(slope)[order]
+        z_mid, width, weight, u = z_mid[order], width[order], weight[order], u[order]
+        c = None if centre is None else (-centre[0], centre[1])
+    return Slices(x_frame, z_mid, width, alpha, weight, u, strength.cohesion, math.tan(strength.friction_angle), c)
+
+
+def bishop_simplified(slices, tolerance=1e-8, max_iterations=200):
+    """Bishop's simplified factor of safety (moments about slices.centre; horizontal interslice
+    forces). For a circle: F = Σ (c l + N′ tan φ) R / Σ W (x_c − x), N′ = [W − u b − c l sin α / F]/m_α,
+    m_α = cos α + sin α tan φ / F. Returns F (inf where nothing drives the mass, nan where no
+    positive F balances it)."""
+    if slices.centre is None:
+        raise ValueError("bishop_simplified needs a moment centre (a circular surface); use spencer for other surfaces")
+    xc, zc = slices.centre
+    a, b, W, u = slices.alpha, slices.width, slices.weight, slices.pore_pressure
+    c, t = slices.cohesion, slices.tan_friction
+    l = slices.base_length
+    rx, rz = slices.x - xc, slices.z - zc
+    shear_arm = -(rx * np.sin(a) + rz * np.cos(a))   # R on a circle
+    normal_arm = rx * np.cos(a) - rz * np.sin(a)     # 0 on a circle
+    driving = -np.sum(W * rx)
+    if driving <= 0:
+        return math.inf
+    F = 1.0
+    for _ in range(max_iterations):
+        m_alpha = np.cos(a) + np.sin(a) * t / F
+        if np.any(m_alpha <= 0.2 * np.cos(a)):
+            # m_α near 0: the steep exit end where the method is known to fail (Whitman & Bailey 1967)
+            m_alpha = np.maximum(m_alpha, 0.2 * np.cos(a))
+        N_eff = (W - u * b - c * l * np.sin(a) / F) / m_alpha
+        resisting = np.sum((c * l + N_eff * t) * shear_arm)
+        F_new = resisting / (driving + np.sum((N_eff + u * l) * normal_arm))
+        if not (np.isfinite(F_new) and F_new > 0):
+            return math.nan  # the base's normal forces outweigh the driving moment: no admissible F
+        if abs(F_new - F) <= tolerance * abs(F):
+            return float(F_new)
+        F = F_new
+    return float(F)
+
+
+def _spencer_q(slices, F, theta):
+    """Net interslice force on each slice; nan where a slice's denominator F cos(α + θ) +
+    tan φ sin(α + θ) is not positive (the normal force on its base would change sign: the same
+    inadmissible range as Bishop's m_α ≤ 0)."""
+    a, W, u, l = slices.alpha, slices.weight, slices.pore_pressure, slices.base_length
+    c, t = slices.cohesion, slices.tan_friction
+    denominator = F * np.cos(a + theta) + t * np.sin(a + theta)
+    if np.any(denominator <= 0):
+        return np.full(a.shape, np.nan)
+    return (c * l + (W * np.cos(a) - u * l) * t - F * W * np.sin(a)) / denominator
+
+
+def _root(f, lo=0.05, hi=50.0, samples=120, tolerance=1e-10):
+    """The smallest root of f in [lo, hi] (log-spaced scan, then bisection), or nan."""
+    grid = np.geomspace(lo, hi, samples)
+    values = np.array([f(x) for x in grid])
+    for i in range(samples - 1):
+        if np.isfinite(values[i]) and np.isfinite(values[i + 1]) and values[i] * values[i + 1] <= 0:
+            a, b, fa = grid[i], grid[i + 1], values[i]
+            for _ in range(200):
+                m = 0.5 * (a + b)
+                fm = f(m)
+                if fa * fm <= 0:
+                    b = m
+                else:
+                    a, fa = m, fm
+                if b - a <= tolerance * m:
+                    break
+            return 0.5 * (a + b)
+    return math.nan
+
+
+def spencer(slices):
+    """Spencer's factor of safety and interslice force inclination θ [rad] for any slip surface.
+    Per slice the net interslice force Q (inclination θ, through the base midpoint) from the
+    slice's equilibrium normal and parallel to its base: Q = [c l + (W cos α − u l) tan φ −
+    F W sin α] / [F cos(α + θ) + tan φ sin(α + θ)]; F and θ make Σ Q = 0 (forces) and
+    Σ Q (x sin θ − z cos θ) = 0 (moments). Solved as F_f(θ) from the force equation, then the θ
+    whose moments vanish at F_f(θ): on a long translational surface the moment sum hardly
+    depends on F, so the usual F_m(θ) may not exist while the pair does."""
+    x, z = slices.x - slices.x.mean(), slices.z - slices.z.mean()
+
+    def force_factor(theta):
+        return _root(lambda F: np.sum(_spencer_q(slices, F, theta)))
+
+    def moment_at_force_balance(theta):
+        F = force_factor(theta)
+        if not np.isfinite(F):
+            return math.nan, F
+        return float(np.sum(_spencer_q(slices, F, theta) * (x * math.sin(theta) - z * math.cos(theta)))), F
+
+    thetas = np.radians(np.linspace(-60, 60, 49))
+    moments = np.array([moment_at_force_balance(th)[0] for th in thetas])
+    for i in range(thetas.size - 1):
+        if np.isfinite(moments[i]) and np.isfinite(moments[i + 1]) and moments[i] * moments[i + 1] <= 0:
+            a, b, ma = thetas[i], thetas[i + 1], moments[i]
+            for _ in range(60):
+                m = 0.5 * (a + b)
+                mm = moment_at_force_balance(m)[0]
+                if not np.isfinite(mm):
+                    break
+                if ma * mm <= 0:
+                    b = m
+                else:
+                    a, ma = m, mm
+                if b - a < 1e-10:
+                    break
+            theta = 0.5 * (a + b)
+            return float(force_factor(theta)), float(theta)
+    raise RuntimeError("spencer: no inclination θ in [−60°, 60°] balances forces and moments on this surface")
+
+
+@dataclass
+class CriticalCircle:
+    factor: float      # the smallest factor of safety found
+    centre: tuple      # (x, z) [m], section frame
+    radius: float      # [m]
+    slices: Slices     # its slices (frame sliding towards +x)
+    searched: int      # circles evaluated
+
+    def surface(self, section, count=60):
+        """The slip surface as (x, z) arrays in the section's frame."""
+        x = self.slices.x * section.direction
+        order = np.argsort(x)
+        return x[order], self.slices.z[order]
+
+
+def _corners(section, min_turn=math.radians(5)):
+    """Vertices of the ground polyline where its inclination turns by more than min_turn: a steep
+    slope's critical circle leaves through its toe, a corner."""
+    x, z = np.asarray(section.surface_x, dtype=float), np.asarray(section.surface_z, dtype=float)
+    angle = np.arctan2(np.diff(z), np.diff(x))
+    turn = np.abs(np.diff(angle)) > min_turn
+    return x[1:-1][turn], z[1:-1][turn]
+
+
+def critical_circle(section, centres_x, centres_z, radii_per_centre=12, min_depth=0.0, slice_count=30,
+                    method=bishop_simplified, zooms=3):
+    """Search for the circle of smallest factor of safety: every centre (x, z) of the grid
+    centres_x × centres_z [m] with radii_per_centre radii from the circle that first cuts the ground
+    to the one tangent to section.base_z (or reaching as deep below the ground's lowest point as
+    the ground is high, without a base), plus the circles through the ground's corners (a steep
+    slope's critical circle passes through its toe); circles shallower than min_depth [m] are
+    skipped (a cohesionless slope's critical surface is otherwise its skin). Then `zooms` times a
+    grid of 7 × 7 centres one spacing around the best, the spacing and radius step shrunk 3×.
+    method: bishop_simplified or spencer (its F is taken)."""
+    section.validate()
+    if not radii_per_centre >= 1:
+        raise ValueError("radii_per_centre = %r is outside the valid range [1, inf)" % radii_per_centre)
+    if not min_depth >= 0:
+        raise ValueError("min_depth = %r m is outside the valid range [0, inf)" % min_depth)
+    ground_x = np.linspace(section.surface_x[0], section.surface_x[-1], 400)
+    ground_z = section.surface(ground_x)
+    bottom = section.base_z if section.base_z is not None else ground_z.min() - (ground_z.max() - ground_z.min())
+    corner_x, corner_z = _corners(section)
+    best, searched = None, 0
+
+    def scan(xs, zs, radius_window):
+        nonlocal best, searched
+        for xc in xs:
+            for zc in zs:
+                r_min = float(np.min(np.hypot(ground_x - xc, ground_z - zc)))
+                r_max = zc - bottom
+                if radius_window is not None:
+                    r_min, r_max = max(r_min, radius_window[0]), min(r_max, radius_window[1])
+                if r_max <= r_min:
+                    continue
+                radii = np.concatenate([np.linspace(r_min, r_max, radii_per_centre + 1)[1:],
+                                        np.hypot(corner_x - xc, corner_z - zc) * (1 + 1e-9)])
+                for radius in radii[(radii > r_min) & (radii <= r_max)]:
+                    slices = slices_of_circle(section, (xc, zc), radius, slice_count, min_depth)
+                    if slices is None:
+                        continue
+                    searched += 1
+                    F = method(slices)
+                    F = F[0] if isinstance(F, tuple) else F
+                    if np.isfinite(F) and F > 0 and (best is None or F < best.factor):
+                        best = CriticalCircle(float(F), (float(xc), float(zc)), float(radius), slices, 0)
+
+    xs, zs = np.atleast_1d(np.asarray(centres_x, dtype=float)), np.atleast_1d(np.asarray(centres_z, dtype=float))
+    scan(xs, zs, None)
+    if best is None:
+        raise ValueError("critical_circle: no circle of the search grid cuts a sliding mass deeper than min_depth = %r m" % min_depth)
+    dx = np.ptp(xs) / max(xs.size - 1, 1) if xs.size > 1 else 0.1 * (ground_z.max() - bottom)
+    dz = np.ptp(zs) / max(zs.size - 1, 1) if zs.size > 1 else 0.1 * (ground_z.max() - bottom)
+    dr = (ground_z.max() - bottom) / radii_per_centre
+    for _ in range(zooms):
+        (xc, zc), r = best.centre, best.radius
+        scan(xc + dx * np.linspace(-1, 1, 7), zc + dz * np.linspace(-1, 1, 7), (r - 2 * dr, r + 2 * dr))
+        dx, dz, dr = dx / 3, dz / 3, dr / 3
+    best.searched = searched
+    return best
+
+
+def infinite_slope_factor(slope_angle, depth, unit_weight, strength, pore_pressure=0.0):
+    """F of an infinite slope (inclination β [rad]) on a slip plane parallel to its surface at
+    vertical depth d [m]: F = [c + (γ d cos²β − u) tan φ] / (γ d sin β cos β), u the pore pressure
+    on the plane [Pa] (seepage parallel to the slope with the water table at the surface:
+    u = γw d cos²β)."""
+    strength.validate()
+    normal = unit_weight * depth * math.cos(slope_angle) ** 2 - pore_pressure
+    return (strength.cohesion + normal * math.tan(strength.friction_angle)) / (unit_weight * depth * math.sin(slope_angle) * math.cos(slope_angle))
+
+
+def section_from_points(solid_positions, solid_masses, water_positions, water_masses, water_pressures, gravity,
+                        width, bin_size, strength, direction=1, base_z=None, surface_offset=0.0):
+    """The 2D section (x–z) of an MPM run, averaged over the out-of-plane width [m].
+
+    Weights: the masses of both phases' points × |gravity| [m s⁻²], binned on a bin_size [m]
+    raster (one cell is a good choice: every bin holds points); a slice's column weight is the
+    binned weight above its base, the bin it cuts counted in proportion. Pore pressure: the mean
+    of the water points' pressures in each bin, bilinear between bin centres, 0 where a bin holds
+    no water (dry). Ground surface: the highest solid point of each bin column + surface_offset
+    [m] (half a point spacing puts it on the points' domain edge)."""
+    if not bin_size > 0:
+        raise ValueError("bin_size = %r m is outside the valid range (0, inf)" % bin_size)
+    if not width > 0:
+        raise ValueError("width = %r m is outside the valid range (0, inf)" % width)
+    g = float(np.linalg.norm(gravity))
+    sp, wp = np.asarray(solid_positions, dtype=float), np.asarray(water_positions, dtype=float)
+    all_pos = np.vstack([sp, wp]) if wp.size else sp
+    x0 = all_pos[:, 0].min() - 0.5 * bin_size
+    z0 = min(all_pos[:, 2].min(), base_z if base_z is not None else np.inf) - 0.5 * bin_size
+    nx = int(np.ceil((all_pos[:, 0].max() + 0.5 * bin_size - x0) / bin_size)) + 1
+    nz = int(np.ceil((all_pos[:, 2].max() + 0.5 * bin_size - z0) / bin_size)) + 1
+
+    def bin_index(pos):
+        i = np.clip(((pos[:, 0] - x0) / bin_size).astype(int), 0, nx - 1)
+        k = np.clip(((pos[:, 2] - z0) / bin_size).astype(int), 0, nz - 1)
+        return i, k
+
+    # weight per unit area of the x–z plane in each bin [N m⁻²] per unit of z: γ_bin [N m⁻³]
+    gamma = np.zeros((nx, nz))
+    i, k = bin_index(sp)
+    np.add.at(gamma, (i, k), np.asarray(solid_masses) * g)
+    if wp.size:
+        i, k = bin_index(wp)
+        np.add.at(gamma, (i, k), np.asarray(water_masses) * g)
+    gamma /= bin_size * bin_size * width
+    # weight above the bottom of each bin, per unit area [Pa]
+    above = np.cumsum(gamma[:, ::-1], axis=1)[:, ::-1] * bin_size
+    centres_x = x0 + bin_size * (np.arange(nx) + 0.5)
+    z_edges = z0 + bin_size * np.arange(nz + 1)
+
+    def column_weight_of(cols, z_base):
+        # weight above z_base [Pa] in the bin columns cols: the bins above in full, the cut one in part
+        kk = np.clip(np.floor((z_base - z0) / bin_size).astype(int), 0, nz - 1)
+        frac = np.clip((z_edges[kk + 1] - z_base) / bin_size, 0, 1)
+        upper = np.where(kk + 1 < nz, above[cols, np.minimum(kk + 1, nz - 1)], 0.0)
+        return upper + frac * gamma[cols, kk] * bin_size
+
+    def column_weight(x, z_base):
+        x, z_base = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(z_base, dtype=float))
+        fx = np.clip((x - centres_x[0]) / bin_size, 0, nx - 1 - 1e-9)
+        i0 = fx.astype(int)
+        tx = fx - i0
+        return (1 - tx) * column_weight_of(i0, z_base) + tx * column_weight_of(np.minimum(i0 + 1, nx - 1), z_base)
+
+    # pore pressure: bin means of the water points, bilinear between bin centres
+    p_sum = np.zeros((nx, nz))
+    p_count = np.zeros((nx, nz))
+    if wp.size:
+        i, k = bin_index(wp)
+        np.add.at(p_sum, (i, k), np.asarray(water_pressures, dtype=float))
+        np.add.at(p_count, (i, k), 1.0)
+    p_bin = np.divide(p_sum, p_count, out=np.zeros_like(p_sum), where=p_count > 0)
+    centres_z = z0 + bin_size * (np.arange(nz) + 0.5)
+
+    def pore_pressure(x, z):
+        x, z = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(z, dtype=float))
+        fx = np.clip((x - centres_x[0]) / bin_size, 0, nx - 1 - 1e-9)
+        fz = np.clip((z - centres_z[0]) / bin_size, 0, nz - 1 - 1e-9)
+        i0, k0 = fx.astype(int), fz.astype(int)
+        i1, k1 = np.minimum(i0 + 1, nx - 1), np.minimum(k0 + 1, nz - 1)
+        tx, tz = fx - i0, fz - k0
+        return ((1 - tx) * (1 - tz) * p_bin[i0, k0] + tx * (1 - tz) * p_bin[i1, k0]
+                + (1 - tx) * tz * p_bin[i0, k1] + tx * tz * p_bin[i1, k1])
+
+    # ground surface: top of the solid points per bin column
+    top = np.full(nx, -np.inf)
+    i, _ = bin_index(sp)
+    np.maximum.at(top, i, sp[:, 2] + surface_offset)
+    has = np.isfinite(top)
+    floor = base_z if base_z is not None else z0
+    top = np.where(has, top, floor)
+    return Section(centres_x, top, column_weight, pore_pressure, strength, direction, base_z).validate()
