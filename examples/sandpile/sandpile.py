@@ -19,9 +19,11 @@ Writes to DIR (default examples/sandpile/out[-quick]):
   pore_pressure.png               pore pressure at four times (x–z view)
   velocity_at_failure.png         solid velocity field at failure
   shear_band.png                  plastic shear strain with the extracted sliding surface
-  time_series.png                 head, pore pressure at probes, slope-face and toe displacement
+  time_series.png                 head, pore pressure at probes, slope-face and toe displacement,
+                                  Bishop's factor of safety on the run's own pore pressures
   time_series.csv                 the same numbers
-  summary.json                    failure head and time, sliding surface, mass balance, run time
+  summary.json                    failure head and time, sliding surface, limit-equilibrium onset
+                                  head, mass balance, run time
 The water mass balance (initial + injected = stored + removed) is checked at every record; the run
 stops with an error if it fails to close to 1e-9. If the solver stops the run as unstable (a point
 moving more than a cell in a step), everything is still written for the time reached and
@@ -153,6 +155,7 @@ O.stopAtTime = DURATION  # the end of the head history; also what the progress E
 steps_per_record = int(round(RECORD_INTERVAL / O.dt))
 records_per_frame = int(round(FIELD_INTERVAL / RECORD_INTERVAL))
 rows, snapshots = [], {}
+lem_records = []  # (time, head, CriticalCircle) of each limit-equilibrium evaluation
 failure = None
 settled = None
 stopped = None  # the solver's message if the run went unstable: what was recorded up to then is kept
@@ -181,6 +184,12 @@ while O.time < DURATION - 1e-12:
            "max_solid_speed_m_per_s": float(speed.max()), "water_points": fluid.count, "injected_kg": engine.injectedWaterMass,
            "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual}
     row.update({"p_%s_Pa" % name.replace(" ", "_"): probe_pressure(loc) for name, loc in PROBES.items()})  # e.g. p_upstream_x=0.05_Pa
+    # Bishop's factor of safety on the run's own pressure field, at every HDF5 frame (about 1 s each)
+    row["lem_factor_of_safety"] = float("nan")
+    if (record - 1) % records_per_frame == 0:
+        circle = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing)
+        row["lem_factor_of_safety"] = circle.factor
+        lem_records.append((O.time, row["head_m"], circle))
     rows.append(row)
     if settled is None and O.time >= SCENE.settle_time - 1e-9:
         settled = dict(row)
@@ -224,6 +233,19 @@ if len(surface_x):
                "band_volume_fraction": float(moving.mean()), "band_strain": BAND_STRAIN,
                "passes_through_toe_region": bool(abs(surface_x.max() - toe) <= 2 * CELL and surface_z[np.argmax(surface_x)] <= 2 * CELL)}
 
+# --- limit equilibrium: the head at which Bishop's factor of safety first falls below 1 -----------
+lem_onset = None
+for (t0, h0, c0), (t1, h1, c1) in zip(lem_records, lem_records[1:]):
+    if c0.factor >= 1 > c1.factor:
+        w = (c0.factor - 1) / (c0.factor - c1.factor)  # linear between the two evaluations
+        lem_onset = {"time_s": t0 + w * (t1 - t0), "head_m": h0 + w * (h1 - h0), "centre_m": list(c1.centre), "radius_m": c1.radius}
+        break
+lem_summary = {"method": "Bishop simplified, critical circle (yade_mpm.slope_stability)",
+               "strength": "c = 0, Davis (1968) for φ = %.0f°, ψ = %.0f°" % (math.degrees(SCENE.friction_angle), math.degrees(SCENE.dilatancy_angle)),
+               "times_s": [r[0] for r in lem_records], "heads_m": [r[1] for r in lem_records],
+               "factors": [r[2].factor for r in lem_records], "onset": lem_onset,
+               "lem_onset_head_m": None if lem_onset is None else lem_onset["head_m"]}
+
 stored, residual = mass_balance()
 summary = {
     "mode": "quick" if args.quick else "full",
@@ -244,6 +266,7 @@ summary = {
                                               "face_displacement_m": failure["face_displacement_m"],
                                               "criterion": "mean displacement of the lower slope face > %.4f m" % FAILURE_DISPLACEMENT},
     "sliding_surface": sliding,
+    "limit_equilibrium": lem_summary,
     "water_mass_balance": {"initial_kg": initial_water, "injected_kg": engine.injectedWaterMass, "removed_kg": engine.removedWaterMass,
                            "stored_kg": stored, "relative_residual": residual},
 }
@@ -302,13 +325,18 @@ sc = ax.scatter(start_positions[:, 0], start_positions[:, 2], c=kappa, s=6, cmap
 fig.colorbar(sc, ax=ax, label="κ, plastic shear strain [-]")
 if len(surface_x):
     ax.plot(surface_x, surface_z, "c-", lw=2, label="sliding surface (base of the band κ > %.2f)" % BAND_STRAIN)
+if lem_records:  # the critical circle at the LEM onset, or where F was lowest
+    below = [r for r in lem_records if r[2].factor < 1]
+    t_c, h_c, circle = below[0] if below else min(lem_records, key=lambda r: r[2].factor)
+    ax.plot(*circle.surface(), "g--", lw=1.5, label="Bishop's critical circle, F = %.2f at t = %.2f s" % (circle.factor, t_c))
+if len(surface_x) or lem_records:
     ax.legend(fontsize=8, loc="upper right")
 frame(ax, "plastic shear strain at t = %.2f s on the undeformed pile" % O.time)
 fig.tight_layout()
 fig.savefig(os.path.join(OUT, "shear_band.png"), dpi=110)
 
 t = np.array([r["time_s"] for r in rows])
-fig, (a1, a2, a3) = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
+fig, (a1, a2, a3, a4) = plt.subplots(4, 1, figsize=(7, 9), sharex=True)
 a1.plot(t, [r["head_m"] for r in rows])
 a1.set_ylabel("inflow head H [m]")
 for key in rows[0]:
@@ -320,11 +348,16 @@ a3.plot(t, 1e3 * np.array([r["face_displacement_m"] for r in rows]), label="lowe
 a3.plot(t, 1e3 * np.array([r["toe_displacement_m"] for r in rows]), label="toe region (mean u_x)")
 a3.axhline(1e3 * FAILURE_DISPLACEMENT, color="r", ls=":", label="failure criterion")
 a3.set_ylabel("displacement [mm]")
-a3.set_xlabel("t [s]")
 a3.legend(fontsize=7)
+a4.plot([r[0] for r in lem_records], [r[2].factor for r in lem_records], "o-", label="Bishop, Davis strength, run's own p")
+a4.axhline(1, color="k", lw=0.8)
+a4.set_ylabel("LEM factor of safety [-]")
+a4.set_xlabel("t [s]")
+a4.legend(fontsize=7)
 if failure:
-    for a in (a1, a2, a3):
+    for a in (a1, a2, a3, a4):
         a.axvline(failure["time_s"], color="r", lw=0.8)
 fig.tight_layout()
 fig.savefig(os.path.join(OUT, "time_series.png"), dpi=110)
 print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "stopped_unstable", "failure", "sliding_surface", "water_mass_balance", "stable_before_rise")}, indent=2))
+print(json.dumps({k: lem_summary[k] for k in ("lem_onset_head_m", "factors")}))

@@ -110,3 +110,21 @@ def pile_points(scene, cell_size, points_per_cell=2):
     X, Y, Z = np.meshgrid(x, y, z, indexing="ij")
     inside = Z < scene.surface_height(X)
     return np.stack([X[inside], Y[inside], Z[inside]], axis=1), spacing
+
+
+def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing):
+    """Bishop's critical circle of the pile's downstream slope on the run's current state
+    (yade_mpm.slope_stability): weights from both phases' point masses, pore pressures from the
+    water points, averaged over the flume's width; the sand's peak strength reduced for its
+    non-associated flow by Davis (φ = 36°, ψ = 6° → φ* = 31.9°); slip circles no deeper than the
+    flume base and at least one cell deep (a thinner slide is below what the MPM resolves).
+    Returns the slope_stability.CriticalCircle (its .factor is the factor of safety)."""
+    from . import slope_stability
+    strength = slope_stability.Strength(cohesion=0.0, friction_angle=scene.friction_angle, dilatancy_angle=scene.dilatancy_angle).davis()
+    section = slope_stability.section_from_points(solid.pos, solid.mass, fluid.pos, fluid.mass, fluid.porePressure, gravity,
+                                                  scene.flume_width, cell_size, strength, direction=1, base_z=0.0,
+                                                  surface_offset=0.5 * point_spacing)
+    height, toe = scene.pile_height, scene.toe_x()
+    return slope_stability.critical_circle(section, np.linspace(scene.crest_length, toe + 0.5 * height, 9),
+                                           np.linspace(1.1 * height, 4 * height, 9), radii_per_centre=10,
+                                           min_depth=cell_size, slice_count=30)

@@ -119,6 +119,7 @@ class Slices:
     cohesion: float
     tan_friction: float
     centre: Optional[tuple] = None  # moment centre (x, z) of a circle, in the same frame
+    direction: int = 1  # the section's: x of this frame × direction is the section's x
 
     @property
     def base_length(self):
@@ -206,7 +207,7 @@ def _build_slices(section, edges, base, centre):
         x_frame, alpha = -mid[order], np.arctan(slope)[order]
         z_mid, width, weight, u = z_mid[order], width[order], weight[order], u[order]
         c = None if centre is None else (-centre[0], centre[1])
-    return Slices(x_frame, z_mid, width, alpha, weight, u, strength.cohesion, math.tan(strength.friction_angle), c)
+    return Slices(x_frame, z_mid, width, alpha, weight, u, strength.cohesion, math.tan(strength.friction_angle), c, s)
 
 
 def bishop_simplified(slices, tolerance=1e-8, max_iterations=200):
@@ -323,9 +324,9 @@ class CriticalCircle:
     slices: Slices     # its slices (frame sliding towards +x)
     searched: int      # circles evaluated
 
-    def surface(self, section, count=60):
-        """The slip surface as (x, z) arrays in the section's frame."""
-        x = self.slices.x * section.direction
+    def surface(self):
+        """The slip surface's base midpoints as (x, z) arrays in the section's frame, x increasing."""
+        x = self.slices.x * self.slices.direction
         order = np.argsort(x)
         return x[order], self.slices.z[order]
 
