@@ -62,6 +62,34 @@ ConstrainedNodes ConstrainedNodes::build(const GridGeometry& grid, const Boundar
 namespace stages {
 	using namespace detail;
 
+	void scaleNodalInertia(GridFields& fields, Real inertiaScale)
+	{
+		const std::size_t count = fields.solid.size();
+		const bool        wet   = fields.water.size() == count;
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t I = 0; I < count; ++I) {
+			fields.solid[I].mass *= inertiaScale;
+			fields.solid[I].momentum *= inertiaScale;
+			if (!wet) continue;
+			fields.water[I].mass *= inertiaScale;
+			fields.water[I].momentum *= inertiaScale;
+		}
+	}
+
+	Real skeletonInertiaRatio(const GridFields& fields, Real dt, Real gravity, Real inertiaScale, Real solidMassTolerance)
+	{
+		Vec3 momentumChange = Vec3::Zero();
+		Real mass           = 0;
+		for (std::size_t I = 0; I < fields.solid.size(); ++I) {
+			const Real m = fields.solid[I].mass;
+			if (!(m > solidMassTolerance)) continue;
+			momentumChange += m * (fields.solidVelocityNew[I] - fields.solidVelocity[I]);
+			mass += m;
+		}
+		if (!(mass > 0 && gravity > 0 && dt > 0)) return 0;
+		return momentumChange.norm() / (dt * gravity * mass / inertiaScale);
+	}
+
 	void markSuctionHoldingNodes(const GridGeometry& grid, const GridFields& fields, Real threshold, Real solidMassTolerance,
 	                             Real waterMassTolerance, std::vector<char>& holding)
 	{

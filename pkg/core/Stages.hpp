@@ -115,6 +115,15 @@ namespace stages {
 	// Step 5: v_I = P_I / m_I for nodes above the mass tolerance, else 0.
 	void computeNodalVelocities(GridFields& fields, Real solidMassTolerance, Real waterMassTolerance);
 
+	// Inertia scaling (theory.md eq. 4.8b): both phases' nodal masses and momenta × α, after the
+	// weights were mapped with the true masses and the velocities taken; every later division of a
+	// force by a nodal mass then sees the inertia α m (drag, stresses and weights are not scaled).
+	void scaleNodalInertia(GridFields& fields, Real inertiaScale);
+	// The net inertial force on the skeleton this step relative to its weight (eq. 4.8c):
+	// |Σ_I m_I (v^{n+1}_I − v^n_I)| / (Δt |g| Σ_I m_I / α) over the nodes with solid mass, the nodal
+	// masses m_I being the scaled ones. 0 without gravity or solid mass.
+	Real skeletonInertiaRatio(const GridFields& fields, Real dt, Real gravity, Real inertiaScale, Real solidMassTolerance);
+
 	// Suction-holding free surface (theory.md eq. 2.3b): marks (1) the nodes whose filling
 	// V^w_I/V^full_I is below `threshold`, that carry solid and water, and whose nodal pore
 	// pressure Σ S V p / Σ S V is negative: there capillary menisci hold the water to the grains.

@@ -88,6 +88,17 @@ const char* stageName(Stage s)
 	return "?";
 }
 
+namespace {
+	// The water's inertial density for the pressure mobility (eq. 8.5 under eq. 4.8b); its weight
+	// and the faces' hydrostatic heads keep the true density.
+	WaterParameters inertialWater(const WaterParameters& water, Real inertiaScale)
+	{
+		WaterParameters w = water;
+		w.density *= inertiaScale;
+		return w;
+	}
+}
+
 void SolverSettings::validate() const
 {
 	requireClosedRange("flipBlend", flipBlend, 0, 1, "");
@@ -100,6 +111,8 @@ void SolverSettings::validate() const
 	requireOpenRange("pressureTolerance", pressureTolerance, 0, inf, "Pa");
 	if (!(pressureCorrections >= 0 && pressureCorrections <= maxPressureCorrections)) throwOutOfRange("pressureCorrections", pressureCorrections, "", "[0, " + std::to_string(maxPressureCorrections) + "]");
 	if (!(maxSubSteps >= 1)) throwOutOfRange("maxSubSteps", maxSubSteps, "", "[1, inf)");
+	if (!(inertiaScale >= 1 && std::isfinite(inertiaScale))) throwOutOfRange("inertiaScale", inertiaScale, "", "[1, inf)");
+	if (!(inertiaScaleRelease > 0)) throwOutOfRange("inertiaScaleRelease", inertiaScaleRelease, "", "(0, inf]");
 	// the relaxations of eqs. 4.17b–c and the suction seal of eq. 2.3b belong to the explicit scheme;
 	// the semi-implicit one is stable without them (theory.md §8.4)
 	if (scheme == TimeScheme::SemiImplicit && pressureModeDamping)
@@ -114,6 +127,7 @@ TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& setti
         , grid_(GridGeometry::forDomain(domain.lower, domain.upper, domain.cellSize, domain.boundaries.periodic))
 {
 	settings_.validate();
+	inertiaScale_ = settings_.inertiaScale;
 	domain_.boundaries.requireFreePeriodicFaces();
 	domain_.boundaries.requireValidPlate();
 	for (int f = 0; f < faceCount; ++f)
@@ -194,7 +208,7 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 TimeStepLimits TwoPhaseSolver::timeStepLimits(Real horizon) const
 {
 	const bool hasWater = !waters_.empty(), semiImplicit = settings_.scheme == TimeScheme::SemiImplicit;
-	const Real rhoW = water_.density, Kw = water_.bulkModulus;
+	const Real rhoW = water_.density * inertiaScale_, Kw = water_.bulkModulus; // inertial density (eq. 4.8b)
 	// explicit: the water's own wave bounds free water; semi-implicit: the pressure is implicit and
 	// free water is bounded by its points' speed alone (eq. 8.10)
 	Real speed = hasWater && !semiImplicit ? std::sqrt(Kw / rhoW) : 0, dragLimit = inf;
@@ -203,7 +217,7 @@ TimeStepLimits TwoPhaseSolver::timeStepLimits(Real horizon) const
 		const SoilParameters& s   = set.soil;
 		const Real            n   = s.porosity;
 		const Real            Ec  = s.constrainedModulus();
-		const Real            rhoS = (1 - n) * s.density;                       // partial density of the skeleton
+		const Real            rhoS = (1 - n) * s.density * inertiaScale_;      // partial (inertial) density of the skeleton, eq. 4.8b
 		speed                     = std::max(speed, std::sqrt(Ec / rhoS));      // skeleton alone (eqs. 5.1, 8.10)
 		if (hasWater && !semiImplicit) {
 			const Real rhoSat = rhoS + n * rhoW;
@@ -213,7 +227,7 @@ TimeStepLimits TwoPhaseSolver::timeStepLimits(Real horizon) const
 				for (Real np : set.points->porosity) nMax = std::max(nMax, np);
 				const Real kappa  = set.kozenyCarman ? s.intrinsicPermeability * (nMax * nMax * nMax / ((1 - nMax) * (1 - nMax))) / (n * n * n / ((1 - n) * (1 - n))) : s.intrinsicPermeability;
 				const Real Q      = nMax * nMax * water_.viscosity / std::min(kappa, s.intrinsicPermeability);
-				const Real lambda = Q * (1 / (nMax * rhoW) + 1 / ((1 - nMax) * s.density));
+				const Real lambda = Q * (1 / (nMax * rhoW) + 1 / ((1 - nMax) * s.density * inertiaScale_));
 				dragLimit         = std::min(dragLimit, 2 / lambda); // theory.md eq. 5.2
 			}
 		}
@@ -256,17 +270,26 @@ AdvanceReport TwoPhaseSolver::advance(Real dt, const std::atomic<bool>* stop)
 	}
 	AdvanceReport report;
 	report.planned = substeps;
-	for (long i = 0; i < substeps; ++i) {
+	Real size = dt / substeps, elapsed = 0;
+	for (long i = 0; i < report.planned; ++i) {
 		if (stop && stop->load(std::memory_order_relaxed)) break;
+		const Real scaleBefore = inertiaScale_;
 		try {
-			step(dt / substeps);
+			step(size);
 		} catch (const InstabilityError& e) {
-			throw InstabilityError(std::string(e.what()) + " (sub-step " + std::to_string(i + 1) + " of " + std::to_string(substeps) + ")");
+			throw InstabilityError(std::string(e.what()) + " (sub-step " + std::to_string(i + 1) + " of " + std::to_string(report.planned) + ")");
 		}
 		++report.subSteps;
+		elapsed += size;
+		if (inertiaScale_ != scaleBefore && i + 1 < report.planned) { // eq. 4.8c released α: the rest follows the true inertia's step
+			const Real rest = dt - elapsed;
+			const long more = subStepsFor(rest, lastLimits_);
+			report.planned  = report.subSteps + more;
+			size            = rest / more;
+		}
 	}
-	// the whole dt exactly when nothing stopped it (no round-off from the product)
-	report.time = report.interrupted() ? report.subSteps * (dt / substeps) : dt;
+	// the whole dt exactly when nothing stopped it (no round-off from the sum)
+	report.time = report.interrupted() ? elapsed : dt;
 	return report;
 }
 
@@ -290,6 +313,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	mapPointsToGrid<Kernel>(wet);                 // Steps 1–5, eqs. 4.1–4.7
 	integrateMomentum(dt, wet, semiImplicit);     // Step 6, eqs. 4.8–4.10 (semi-implicit: predictor S1)
 	if (semiImplicit) projectPressure<Kernel>(dt); // S2–S3, eqs. 8.7–8.8
+	if (inertiaScale_ != 1) checkQuasiStatic(dt); // eq. 4.8c
 	const bool projectedRates = semiImplicit && settings_.shapeFunction != ShapeFunction::Linear;
 	if (projectedRates) skeletonRates<Kernel>();  // S4a, eq. 8.9: from v^{n+1} at x^n
 	movePoints<Kernel>(dt);                       // Step 7, eq. 4.11; water in and out, eqs. 2.4–2.5
@@ -315,7 +339,7 @@ std::vector<ProjectionForms> TwoPhaseSolver::projectionFormsWith(Real dt, const 
 	mapPointsToGrid<Kernel>(true);
 	integrateMomentum(dt, true, true);
 	classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, settings_.gravity, water_.density, pressureSystem_);
-	assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, water_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, pressureSystem_);
+	assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, pressureSystem_);
 	buildPressureMatrix(grid_, pressureSystem_);
 	plate_ = plate;
 	std::vector<Vec3> freeNodes(static_cast<std::size_t>(pressureSystem_.matrix.rows()));
@@ -329,6 +353,15 @@ std::vector<ProjectionForms> TwoPhaseSolver::projectionFormsWith(Real dt, const 
 		forms.push_back(stages::projectionForms<Kernel>(grid_, fields_, solids_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, p,
 		                                                pressureSystem_));
 	return forms;
+}
+
+void TwoPhaseSolver::checkQuasiStatic(Real dt)
+{
+	lastInertiaRatio_ = stages::skeletonInertiaRatio(fields_, dt, settings_.gravity.norm(), inertiaScale_, solidMassTolerance_);
+	if (lastInertiaRatio_ > settings_.inertiaScaleRelease) {
+		inertiaScale_       = 1; // from the next step on; this step's motion stands as computed
+		inertiaReleaseStep_ = steps_;
+	}
 }
 
 void TwoPhaseSolver::resetGridStage(bool wet)
@@ -362,6 +395,7 @@ void TwoPhaseSolver::integrateMomentum(Real dt, bool wet, bool semiImplicit)
 	using namespace stages;
 	StageTimer t(stageSeconds_, Stage::IntegrateNodalMomentum);
 	computeNodalVelocities(fields_, solidMassTolerance_, waterMassTolerance_);
+	if (inertiaScale_ != 1) scaleNodalInertia(fields_, inertiaScale_); // eq. 4.8b
 	const bool holdSuction = wet && settings_.freeSurfaceHoldsSuction;
 	if (holdSuction) markSuctionHoldingNodes(grid_, fields_, settings_.freeSurfaceThreshold, solidMassTolerance_, waterMassTolerance_, suctionHolding_);
 	// the semi-implicit step takes the drag implicitly (its corrector is the implicit 2×2 system, and
@@ -378,7 +412,7 @@ template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
 	{
 		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.1–8.7
 		classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, pressureSystem_);
-		assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, water_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
+		assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
 		                               pressureSystem_);
 		if (!constrained_.plate.empty()) assemblePlateCoupling<Kernel>(grid_, fields_, solids_, waters_, constrained_, plate_, dt, pressureSystem_);
 		else pressureSystem_.plateCoupling.clear();
@@ -437,8 +471,9 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 			for (std::size_t I = 0; I < nodes; ++I) {
 				const Vec3 toWater = solidDragLoss_[I], toSolid = waterDragLoss_[I];
-				solidDragLoss_[I]  = solidRetention_[I] < 1 ? Vec3(toSolid / fields_.solid[I].mass) : Vec3::Zero();
-				waterDragLoss_[I]  = waterRetention_[I] < 1 ? Vec3(toWater / fields_.water[I].mass) : Vec3::Zero();
+				// the points' momenta are of the inertia α m too (eq. 4.8b)
+				solidDragLoss_[I]  = solidRetention_[I] < 1 ? Vec3(inertiaScale_ * toSolid / fields_.solid[I].mass) : Vec3::Zero();
+				waterDragLoss_[I]  = waterRetention_[I] < 1 ? Vec3(inertiaScale_ * toWater / fields_.water[I].mass) : Vec3::Zero();
 			}
 		}
 		for (std::size_t s = 0; s < solids_.size(); ++s)

@@ -29,6 +29,8 @@ struct SolverSettings {
 	Real          freeSurfaceThreshold       = 0;    // β [-], 0 ≤ β < 1: p = 0 on points filled below β (eq. 2.3); 0: off
 	bool          freeSurfaceHoldsSuction    = false; // eq. 2.3b (explicit scheme only): the surface keeps suction (p < 0) and releases only p > 0
 	long          maxSubSteps                = 100000; // N_max [-] ≥ 1: advance(dt) refuses a dt that needs more sub-steps than this (a mistyped step, not a run)
+	Real          inertiaScale               = 1;    // α [-] ≥ 1: both phases' inertia × α, weights, drag and stresses not (eq. 4.8b); the step grows as √α
+	Real          inertiaScaleRelease        = 0.1;  // ε [-] > 0: α returns to 1 for good once the skeleton's net inertial force exceeds ε × its weight (eq. 4.8c); inf: never
 	void          validate() const;
 };
 
@@ -120,6 +122,12 @@ public:
 	const PressureSolveReport&                          lastPressureSolve() const { return lastPressureSolve_; }
 	const PressureSystem&                               pressureSystem() const { return pressureSystem_; } // the last step's (tests, diagnostics)
 	const GridFields&                                   fields() const { return fields_; }
+	// The inertia scale in force (eq. 4.8b): settings().inertiaScale until the release of eq. 4.8c, 1 after it.
+	Real                                                currentInertiaScale() const { return inertiaScale_; }
+	// The step (stepCount()) whose motion released the inertia scale, −1 while it holds; and the
+	// skeleton's inertial-force ratio of the last step (eq. 4.8c) [-].
+	long                                                inertiaScaleReleaseStep() const { return inertiaReleaseStep_; }
+	Real                                                lastInertiaRatio() const { return lastInertiaRatio_; }
 	const SolverSettings&                               settings() const { return settings_; }
 	// A check of the semi-implicit projection (theory.md §8.6, tests): runs the stages of a step of
 	// size dt up to the assembled system of eq. 8.7, without moving any point, and returns the
@@ -185,6 +193,10 @@ private:
 	PressureSolveReport           lastPressureSolve_ {};
 	std::vector<std::array<bool, 3>> heldSolid_; // per constrained node: solid components held this step
 	Real                          pressureDiffusivity_ = 0; // c_v [m² s⁻¹] of eq. 4.17b
+	Real                          inertiaScale_        = 1;  // α in force (eq. 4.8b)
+	long                          inertiaReleaseStep_  = -1; // step that released α (eq. 4.8c), −1: not released
+	Real                          lastInertiaRatio_    = 0;  // eq. 4.8c of the last step [-]
+	void                          checkQuasiStatic(Real dt); // eq. 4.8c
 	std::array<double, static_cast<int>(Stage::Count)> stageSeconds_ {};
 };
 

@@ -150,6 +150,13 @@ void MpmTwoPhaseEngine::action()
 	waterPointCount  = fluid;
 	lastDt           = dt;
 	lastIter         = yade::abi::iter(scene);
+	inertiaRatio     = solver_->lastInertiaRatio();
+	if (solver_->inertiaScaleReleaseStep() >= 0 && settings_.inertiaScale != 1) {
+		// eq. 4.8c released α for good: the attribute says so (and a saved scene keeps it), the
+		// solver runs on without a rebuild
+		settings_.inertiaScale  = 1;
+		inertiaScaleReleaseTime = mpmTime + advanced.time;
+	}
 	mpmTime += advanced.time;
 	++stepsDone;
 	if (interrupted) stopAfterInterrupt(dt, advanced);
@@ -270,6 +277,8 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		valueAttr<E>("removeFreeWater", [](E& e) -> auto& { return e.domain_.removeFreeWater; }, "Remove water points that have left the soil (no solid in their stencil, n = 1), e.g. seepage caught by a filtering cloth; their mass counts in removedWaterMass [-]"),
 		listAttr<E>("waterInflow", 6, faces, [](E& e, int f) -> auto& { return e.domain_.boundaries.walls[f].inflow; }, "Per face (xMin..zMax), whether water drawn in through that 'drained' face is supplied as new water points (theory.md eq. 2.5) [-]"),
 		listAttr<E>("periodic", 3, "x, y, z", [](E& e, int axis) -> auto& { return e.domain_.boundaries.periodic[axis]; }, "Per axis (x, y, z), whether the domain repeats along it (theory.md eq. 2.7): points leaving through one face enter through the other, the two faces are no walls (their solidWalls/waterWalls must stay 'free', with no inflow, drained pressure, friction or water table) and the axis needs at least 3 cells [-]"),
+		valueAttr<E>("inertiaScale", [](E& e) -> auto& { return e.settings_.inertiaScale; }, "Inertia scaling α [-], ≥ 1, default 1 (theory.md eq. 4.8b): both phases' inertia × α, their weights, the drag and the stresses not, so a quasi-static process (a slow head rise) keeps its drainage kinetics while the step grows as √α (the skeleton's wave slows by √α). Returns to 1 for good, by itself, once the skeleton's net inertial force exceeds inertiaScaleRelease × its weight (eq. 4.8c; the time is kept in inertiaScaleReleaseTime). Measured: Terzaghi's consolidation at k = 1e-5 m/s unchanged within 0.1% of p0 with α = 100 in a tenth of the steps"),
+		valueAttr<E>("inertiaScaleRelease", [](E& e) -> auto& { return e.settings_.inertiaScaleRelease; }, "Release threshold ε of inertiaScale [-], > 0, default 0.1 (inf: never): α returns to 1 once |Σ m_I Δv_I| α/(Δt |g| Σ m_I), the skeleton's net inertial force over its weight (eq. 4.8c), exceeds ε. It measures the force imbalance whatever α: a block sliding at 45° on a 30° base gives 0.30, the elastic bounce of a stuck one 0.05. A slide of a fraction f of the skeleton with imbalance r shows as about f r: set ε below it"),
 		readOnly(valueAttr<E>("removedWaterMass", member(&E::removedWaterMass), "Water mass removed by waterSinks and at the grid's edge since the start [kg]")),
 		readOnly(valueAttr<E>("injectedWaterMass", member(&E::injectedWaterMass), "Water mass supplied as new water points through waterInflow faces since the start [kg]")),
 		readOnly(valueAttr<E>("stepsDone", member(&E::stepsDone), "Number of times the engine ran [-]")),
@@ -282,6 +291,8 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		readOnly(valueAttr<E>("solverSteps", member(&E::solverSteps), "Explicit steps since the solver was (re)built [-]")),
 		readOnly(valueAttr<E>("criticalTimeStep", member(&E::criticalTimeStep), "Critical time step of the last run before timeStepFactor [s]: semi-implicit, h/(skeleton wave + fastest point) (theory.md eq. 8.10); explicit, min of h/(fastest wave + fastest point) and, with explicit drag, the drag limit (eqs. 5.1–5.2)")),
 		readOnly(valueAttr<E>("pressureSolveIterations", member(&E::pressureSolveIterations), "Conjugate-gradient iterations of the last pressure solve of the semi-implicit scheme [-]")),
+		readOnly(valueAttr<E>("inertiaScaleReleaseTime", member(&E::inertiaScaleReleaseTime), "End of the O.dt in which inertiaScale returned to 1 (theory.md eq. 4.8c) [s]; -1 while it holds or was never set")),
+		readOnly(valueAttr<E>("inertiaRatio", member(&E::inertiaRatio), "The skeleton's net inertial force over its weight in the last sub-step while inertiaScale ≠ 1 (theory.md eq. 4.8c) [-]")),
 		};
 		for (auto& spec : t)
 			if (spec.set && !spec.inPlace) spec.set = [set = spec.set](E& e, const py::object& v) {

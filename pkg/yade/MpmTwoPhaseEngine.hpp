@@ -30,6 +30,8 @@ public:
 	long       pressureSolveIterations = 0; // conjugate-gradient iterations of the last pressure solve (semi-implicit) [-]
 	yade::Real removedWaterMass = 0; // water mass removed by sinks and at the grid's edge, in total [kg]
 	yade::Real injectedWaterMass = 0; // water mass supplied through inflow faces, in total [kg]
+	yade::Real inertiaScaleReleaseTime = -1; // end of the O.dt in which inertiaScale returned to 1 (eq. 4.8c); −1: not released [s]
+	yade::Real inertiaRatio = 0; // the skeleton's net inertial force / weight in the last sub-step while α ≠ 1 (eq. 4.8c) [-]
 
 	MpmTwoPhaseEngine() = default;
 	~MpmTwoPhaseEngine() override;
