@@ -355,6 +355,18 @@ std::vector<ProjectionForms> TwoPhaseSolver::projectionFormsWith(Real dt, const 
 	return forms;
 }
 
+Real TwoPhaseSolver::drainageRelaxationTime() const
+{
+	if (waters_.empty()) return inf;
+	Real shortest = inf;
+	for (const SolidSet& set : solids_) {
+		const SoilParameters& s = set.soil;
+		const Real rhoSat = ((1 - s.porosity) * s.density + s.porosity * water_.density) * inertiaScale_;
+		shortest = std::min(shortest, rhoSat * s.intrinsicPermeability / water_.viscosity);
+	}
+	return shortest;
+}
+
 void TwoPhaseSolver::checkQuasiStatic(Real dt)
 {
 	lastInertiaRatio_ = stages::skeletonInertiaRatio(fields_, dt, settings_.gravity.norm(), inertiaScale_, solidMassTolerance_);

@@ -31,6 +31,7 @@ public:
 	yade::Real removedWaterMass = 0; // water mass removed by sinks and at the grid's edge, in total [kg]
 	yade::Real injectedWaterMass = 0; // water mass supplied through inflow faces, in total [kg]
 	yade::Real inertiaScaleReleaseTime = -1; // end of the O.dt in which inertiaScale returned to 1 (eq. 4.8c); −1: not released [s]
+	yade::Real drainageStepRatio = 0; // Δt/τ of the last sub-step, τ = α ρsat κ/μw (theory.md §8.7b) [-]
 	yade::Real inertiaRatio = 0; // the skeleton's net inertial force / weight in the last sub-step while α ≠ 1 (eq. 4.8c) [-]
 
 	MpmTwoPhaseEngine() = default;

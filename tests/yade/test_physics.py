@@ -57,6 +57,9 @@ def test_engine_sub_steps_to_the_critical_time_step(scheme):
         wave = np.sqrt(e_oed / (0.6 * 2650))
     assert engine.criticalTimeStep == pytest.approx(0.05 / wave, rel=1e-9)
     assert engine.subStepsLast == int(np.ceil(1e-3 / (engine.timeStepFactor * engine.criticalTimeStep)))
+    # Δt/τ, τ = ρsat κ/μw (theory.md §8.7b): what decides the semi-implicit stabilisation's spurious drainage
+    tau = (0.6 * 2650 + 0.4 * 1000) * soil.intrinsicPermeability / water.viscosity
+    assert engine.drainageStepRatio == pytest.approx(1e-3 / engine.subStepsLast / tau, rel=1e-9)
 
 
 def test_incompressible_water_needs_and_gets_the_semi_implicit_scheme():
