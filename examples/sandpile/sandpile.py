@@ -31,6 +31,7 @@ summary.json carries the solver's message under "stopped_unstable".
 """
 import argparse
 import csv
+import dataclasses
 import json
 import math
 import os
@@ -48,16 +49,27 @@ parser.add_argument("--quick", action="store_true", help="2 cm cells: a few minu
 parser.add_argument("--cell", type=float, help="cell size h [m] (default 0.02 quick, 0.01 full)")
 parser.add_argument("--duration", type=float, help="stop after this time [s] (default: the whole head history)")
 parser.add_argument("--out", help="output directory")
+parser.add_argument("--scheme", choices=("explicit", "semi-implicit"), default="explicit",
+                    help="explicit (default: with the suction-holding seepage face and the relaxations of theory.md eqs. 4.17b-c) or "
+                         "semi-implicit (no relaxation; no capillary face yet, so the sand above the water table starts dry)")
+parser.add_argument("--inertia-scale", type=float, default=1.0, help="inertia scaling α ≥ 1 of both phases (theory.md eq. 4.8b), released "
+                                                                     "by itself when the pile accelerates (eq. 4.8c)")
+parser.add_argument("--ramp-time", type=float, help="duration of the head rise [s] (default the scene's 0.3 s)")
+parser.add_argument("--hold-time", type=float, help="head held at the crest after the rise [s] (default the scene's 0.35 s)")
 args = parser.parse_args(sys.argv[1:])
 
 SCENE = sandpile.DEFAULT
+if args.ramp_time is not None or args.hold_time is not None:
+    SCENE = dataclasses.replace(SCENE, head_ramp_time=SCENE.head_ramp_time if args.ramp_time is None else args.ramp_time,
+                                hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time)
+SEMI_IMPLICIT = args.scheme == "semi-implicit"
 GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
 G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]
 CELL = args.cell or (0.02 if args.quick else 0.01)  # h [m]
 DURATION = args.duration or SCENE.duration()  # [s]
 OUT = args.out or os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "out-quick" if args.quick else "out")
-RECORD_INTERVAL = 0.01  # time between time-series samples [s]
-FIELD_INTERVAL = 0.05   # time between HDF5 frames [s]
+RECORD_INTERVAL = SCENE.duration() / 70  # time between time-series samples: 0.01 s for the default history [s]
+FIELD_INTERVAL = 5 * RECORD_INTERVAL     # time between HDF5 frames and limit-equilibrium evaluations [s]
 FAILURE_DISPLACEMENT = 0.01 * SCENE.pile_height  # mean displacement of the lower slope face that marks failure [m]
 # plastic shear strain that marks a point as part of the shear band: ten softening scales, where the
 # sand has reached its critical state (φ within e⁻¹⁰ of φ_r) [-]
@@ -67,6 +79,11 @@ if not 0 < CELL <= SCENE.pile_height / 4:
     raise ValueError("--cell = %r m is outside the valid range (0, %g] (at least 4 cells over the pile height)" % (CELL, SCENE.pile_height / 4))
 if not DURATION > 0:
     raise ValueError("--duration = %r s is outside the valid range (0, inf)" % DURATION)
+if not args.inertia_scale >= 1:
+    raise ValueError("--inertia-scale = %r is outside the valid range [1, inf)" % args.inertia_scale)
+SCENE.validate()
+if not (SCENE.head_ramp_time > 0 and SCENE.hold_time >= 0):
+    raise ValueError("--ramp-time = %r s and --hold-time = %r s must lie in (0, inf) and [0, inf)" % (SCENE.head_ramp_time, SCENE.hold_time))
 os.makedirs(OUT, exist_ok=True)
 
 # --- materials and points -------------------------------------------------------------------------
@@ -79,7 +96,10 @@ O.materials.append([soil, water])
 positions, spacing = sandpile.pile_points(SCENE, CELL, points_per_cell=2)
 solid_body, water_body = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=GRAVITY,
                                                    surface=SCENE.surface_height(positions[:, 0]), water_table=SCENE.head_start,
-                                                   lateral_earth_pressure=1 - math.sin(SCENE.friction_angle), suction_above_table=True)
+                                                   lateral_earth_pressure=1 - math.sin(SCENE.friction_angle),
+                                                   # the explicit scheme's surface holds the suction; the semi-implicit one has
+                                                   # no capillary face yet, so there the sand above the table is dry
+                                                   suction_above_table=not SEMI_IMPLICIT, dry_above_table=SEMI_IMPLICIT)
 O.bodies.append([solid_body, water_body])
 solid, fluid = solid_body.shape, water_body.shape
 start_positions = solid.pos.copy()
@@ -89,9 +109,9 @@ NO_TABLE = float("-inf")
 engine = MpmTwoPhaseEngine(
     label="mpm", gravity=GRAVITY, domainMin=(0, 0, 0), domainMax=(SCENE.flume_length, SCENE.flume_width, SCENE.flume_height),
     cellSize=CELL, shapeFunction="uGIMP",
-    # the pile still runs on the explicit scheme with its relaxations (theory.md eqs. 4.17b-c, 2.3b);
-    # porting it to the default semi-implicit scheme is the sand-pile issue's work
-    scheme="explicit", pressureModeDamping=True,
+    # by default the pile still runs on the explicit scheme with its relaxations (theory.md eqs.
+    # 4.17b-c, 2.3b); porting it to the semi-implicit scheme is the sand-pile issue's work
+    scheme=args.scheme, pressureModeDamping=not SEMI_IMPLICIT, inertiaScale=args.inertia_scale,
     #            xMin (inflow)  xMax      yMin (front)   yMax (rear)    zMin (base)    zMax
     solidWalls=("slip",        "free",   "slip",        "slip",        "frictional",  "free"),
     wallFriction=(0,           0,        0,             0,             math.tan(SCENE.base_friction_angle), 0),
@@ -99,7 +119,7 @@ engine = MpmTwoPhaseEngine(
     waterInflow=(True, False, False, False, False, False),
     drainedWaterTable=(SCENE.head_start, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE),
     freeSurfaceThreshold=0.75,  # the outer point layer is the pile's surface ...
-    freeSurfaceHoldsSuction=True,  # ... held by capillarity above the phreatic line, a seepage face below it
+    freeSurfaceHoldsSuction=not SEMI_IMPLICIT,  # ... held by capillarity above the phreatic line, a seepage face below it
     removeFreeWater=True)       # the filtering cloth
 recorder = MpmHdf5Recorder(label="recorder", file=os.path.join(OUT, "sandpile.h5"), iterPeriod=1)
 O.engines = [engine, recorder, yade_mpm.progress(seconds=60)]  # a progress line with an ETA every minute
@@ -150,7 +170,7 @@ def mass_balance():
 
 # --- run -------------------------------------------------------------------------------------------
 # O.dt is the interval at which the head is updated; the engine sub-steps it to its stable step.
-O.dt = 2e-4
+O.dt = RECORD_INTERVAL / 50  # 2e-4 s for the default history
 O.stopAtTime = DURATION  # the end of the head history; also what the progress ETA refers to
 steps_per_record = int(round(RECORD_INTERVAL / O.dt))
 records_per_frame = int(round(FIELD_INTERVAL / RECORD_INTERVAL))
@@ -182,7 +202,7 @@ while O.time < DURATION - 1e-12:
     speed = np.linalg.norm(solid.vel, axis=1)
     row = {"time_s": O.time, "head_m": SCENE.head(O.time), "toe_displacement_m": toe_displacement(), "face_displacement_m": face_displacement(),
            "max_solid_speed_m_per_s": float(speed.max()), "water_points": fluid.count, "injected_kg": engine.injectedWaterMass,
-           "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual}
+           "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual, "inertia_scale": engine.inertiaScale}
     row.update({"p_%s_Pa" % name.replace(" ", "_"): probe_pressure(loc) for name, loc in PROBES.items()})  # e.g. p_upstream_x=0.05_Pa
     # Bishop's factor of safety on the run's own pressure field, at every HDF5 frame (about 1 s each)
     row["lem_factor_of_safety"] = float("nan")
@@ -201,8 +221,9 @@ while O.time < DURATION - 1e-12:
     mid = SCENE.settle_time + 0.5 * SCENE.head_ramp_time
     if "mid rise" not in snapshots and O.time >= mid - 1e-9:
         snapshots["mid rise"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
-    print("t = %.3f s  head %.4f m  toe %.2e m  face %.2e m  max |v_s| %.2e m/s  water points %d  balance %.1e  (%.0f s)"
-          % (O.time, row["head_m"], row["toe_displacement_m"], row["face_displacement_m"], row["max_solid_speed_m_per_s"], fluid.count, residual, time.time() - wall_start),
+    print("t = %.3f s  head %.4f m  toe %.2e m  face %.2e m  max |v_s| %.2e m/s  water points %d  balance %.1e  α %g  LEM F %.3f  (%.0f s)"
+          % (O.time, row["head_m"], row["toe_displacement_m"], row["face_displacement_m"], row["max_solid_speed_m_per_s"], fluid.count, residual,
+             engine.inertiaScale, row["lem_factor_of_safety"], time.time() - wall_start),
           flush=True)
 run_time = time.time() - wall_start
 snapshots["end"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
@@ -255,6 +276,9 @@ summary = {
     "gravity_m_per_s2": GRAVITY.tolist(),
     "simulated_time_s": O.time,
     "stopped_unstable": stopped,
+    "scheme": args.scheme,
+    "inertia_scale": args.inertia_scale,
+    "inertia_scale_release_time_s": engine.inertiaScaleReleaseTime if engine.inertiaScaleReleaseTime >= 0 else None,
     "explicit_steps": int(engine.solverSteps),
     "critical_time_step_s": engine.criticalTimeStep,
     "run_time_s": run_time,

@@ -56,7 +56,7 @@ def saturated_block(lower, upper, cell_size, soil, water, points_per_cell=2, gra
 
 
 def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), surface=None, water_table=None,
-                     lateral_earth_pressure=None, suction_above_table=False):
+                     lateral_earth_pressure=None, suction_above_table=False, dry_above_table=False):
     """Solid and water points at the same `positions` (N×3 [m]), each the centre of a cube of side
     `spacing` [m] (V0 = spacing³, GIMP half-length spacing/2), with porosity soil.porosity.
 
@@ -70,7 +70,9 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
     σ′_xz = ρsat b_x (surface − z), σ′_yz = ρsat b_y (surface − z), and the water seeps parallel to
     the slope at Darcy's rate, n (v_w − v_s) = (κ/μw) ρw (b_x, b_y, 0), which its drag hands to the
     skeleton (theory.md §7.5); level gravity leaves the water at rest. Without gravity the points
-    start stress-free at p = 0.
+    start stress-free at p = 0. With `dry_above_table` (level gravity only) there are water points
+    only below the table: the sand above it is dry, and the skeleton carries its dry weight
+    (1 − n) ρs |b_z| above the table and the saturated weight below it, less p.
 
     Returns (solid_body, water_body), two non-dynamic Bodies to append to O.bodies.
     """
@@ -103,7 +105,15 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
         pore_pressure = rho_w * g * (float(water_table) - z)
         if not suction_above_table:
             pore_pressure = np.clip(pore_pressure, 0, None)
-        vertical = -(rho_sat * g * (surface - z) - pore_pressure)
+        if dry_above_table:
+            if suction_above_table or gravity[:2].any():
+                raise ValueError("dry_above_table needs level gravity and no suction_above_table")
+            rho_dry = (1 - n0) * soil.density
+            table = float(water_table)
+            total = g * (rho_dry * np.clip(surface - np.maximum(z, table), 0, None) + rho_sat * np.clip(np.minimum(surface, table) - z, 0, None))
+            vertical = -(total - pore_pressure)
+        else:
+            vertical = -(rho_sat * g * (surface - z) - pore_pressure)
         k0 = soil.poissonRatio / (1 - soil.poissonRatio) if lateral_earth_pressure is None else float(lateral_earth_pressure)
         stress[:, 0, 0] = stress[:, 1, 1] = k0 * vertical
         stress[:, 2, 2] = vertical
@@ -122,14 +132,15 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
     solid.porosity = np.full(count, n0)
     solid.stress = stress
 
-    fluid = _w.MpmWaterPoints(pos=positions)
-    fluid.mass = n0 * water.density * volume
-    fluid.volume = volume
-    fluid.halfLength = half
-    fluid.porosity = np.full(count, n0)
-    fluid.porePressure = pore_pressure
+    wet = np.ones(count, dtype=bool) if not (dry_above_table and g > 0) else z < float(water_table)
+    fluid = _w.MpmWaterPoints(pos=positions[wet])
+    fluid.mass = n0 * water.density * volume[wet]
+    fluid.volume = volume[wet]
+    fluid.halfLength = half[wet]
+    fluid.porosity = np.full(int(wet.sum()), n0)
+    fluid.porePressure = pore_pressure[wet]
     if g > 0:
-        fluid.vel = water_velocity
+        fluid.vel = water_velocity[wet]
 
     bodies = []
     for shape, material in ((solid, soil), (fluid, water)):
