@@ -353,7 +353,7 @@ def test_inertia_scale_is_released_when_a_block_starts_to_slide_and_the_release_
     assert O.engines[0].inertiaScale == 1 and O.engines[0].inertiaScaleReleaseTime == pytest.approx(1e-3, rel=1e-9)
 
 
-def dry_over_wet_column(height=0.5, cell=0.05, table=0.3, corrections=0):
+def dry_over_wet_column(height=0.5, cell=0.05, table=0.3, corrections=0, scheme="semi-implicit"):
     soil = w.MpmSoilMat(density=2650, youngModulus=20e6, poissonRatio=0.3, porosity=0.4, intrinsicPermeability=1e-10)
     water = w.MpmWaterMat(density=1000, bulkModulus=2.2e9, viscosity=1e-3)
     O.materials.append([soil, water])
@@ -366,7 +366,7 @@ def dry_over_wet_column(height=0.5, cell=0.05, table=0.3, corrections=0):
     O.bodies.append([solid_body, water_body])
     O.engines = [w.MpmTwoPhaseEngine(gravity=G, domainMin=(0, 0, 0), domainMax=(cell, cell, height + 2 * cell), cellSize=cell,
                                      solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("free",),
-                                     freeSurfaceThreshold=0.75, pressureCorrections=corrections)]
+                                     freeSurfaceThreshold=0.75, pressureCorrections=corrections, scheme=scheme)]
     return positions, solid_body.shape, water_body.shape
 
 
@@ -397,3 +397,21 @@ def test_phreatic_surface_inside_the_soil_stays_at_rest():
     assert np.linalg.norm(fluid.vel, axis=1).max() < 1e-5
     hydrostatic = 1000 * 9.81 * np.clip(0.3 - fluid.pos[:, 2], 0, None)
     assert np.abs(fluid.porePressure - hydrostatic).max() < 0.02 * 1000 * 9.81 * 0.3
+
+
+@pytest.mark.xfail(strict=True, reason="a saturated soil surface between node planes is not at rest on the semi-implicit step "
+                                       "(theory.md §8 Open): the surface node above it is held at p = 0 half a cell above the water, the "
+                                       "column's pressure is that of a table at the node (base +240 Pa) and its top water rises 2.3 cm in "
+                                       "0.3 s, then 2.5 mm/s")
+def test_saturated_surface_between_node_planes_stays_at_rest():
+    """A saturated column whose surface (soil and water, 0.275 m) lies half a cell below a node
+    plane, semi-implicit, k = 1e-3 m/s: at rest, its water's speeds must stay below 1e-5 m/s over
+    0.3 s and its base pressure within 1% of γw H. (On a node plane, 0.3 m, it is hydrostatic to
+    round-off; the explicit scheme, whose free-surface points are reset to p = 0, keeps the base
+    pressure to 0.3%.)"""
+    _, solid, fluid = dry_over_wet_column(height=0.275, table=0.275)
+    O.dt = 1e-3
+    O.run(300, True)
+    assert np.linalg.norm(fluid.vel, axis=1).max() < 1e-5
+    base = np.argmin(fluid.pos[:, 2])
+    assert abs(fluid.porePressure[base] - 1000 * 9.81 * (0.275 - fluid.pos[base, 2])) < 0.01 * 1000 * 9.81 * 0.275
