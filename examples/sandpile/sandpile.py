@@ -22,8 +22,10 @@ Writes to DIR (default examples/sandpile/out[-quick]):
   time_series.png                 head, pore pressure at probes, slope-face and toe displacement,
                                   Bishop's factor of safety on the run's own pore pressures
   time_series.csv                 the same numbers
-  summary.json                    failure head and time, sliding surface, limit-equilibrium onset
-                                  head, mass balance, run time
+  summary.json                    failure head and time, kinematic onset (onset_head_m), run-out
+                                  (runout_m), deposit profile, mobilised volume, sliding surface,
+                                  limit-equilibrium onset head (lem_onset_head_m), water balance
+                                  (injected_kg, removed_kg, relative_residual), run time
 The water mass balance (initial + injected = stored + removed) is checked at every record; the run
 stops with an error if it fails to close to 1e-9. If the solver stops the run as unstable (a point
 moving more than a cell in a step), everything is still written for the time reached and
@@ -202,7 +204,8 @@ while O.time < DURATION - 1e-12:
     speed = np.linalg.norm(solid.vel, axis=1)
     row = {"time_s": O.time, "head_m": SCENE.head(O.time), "toe_displacement_m": toe_displacement(), "face_displacement_m": face_displacement(),
            "max_solid_speed_m_per_s": float(speed.max()), "water_points": fluid.count, "injected_kg": engine.injectedWaterMass,
-           "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual, "inertia_scale": engine.inertiaScale}
+           "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual, "inertia_scale": engine.inertiaScale,
+           "kinetic_energy_J": yade_mpm.analysis.kinetic_energy(solid.mass, solid.vel)}
     row.update({"p_%s_Pa" % name.replace(" ", "_"): probe_pressure(loc) for name, loc in PROBES.items()})  # e.g. p_upstream_x=0.05_Pa
     # Bishop's factor of safety on the run's own pressure field, at every HDF5 frame (about 1 s each)
     row["lem_factor_of_safety"] = float("nan")
@@ -267,6 +270,15 @@ lem_summary = {"method": "Bishop simplified, critical circle (yade_mpm.slope_sta
                "factors": [r[2].factor for r in lem_records], "onset": lem_onset,
                "lem_onset_head_m": None if lem_onset is None else lem_onset["head_m"]}
 
+# --- kinematic onset (sustained growth of the skeleton's kinetic energy), run-out, deposit ---------
+times = np.array([r["time_s"] for r in rows])
+onset_index = yade_mpm.analysis.kinetic_onset(times, [r["kinetic_energy_J"] for r in rows])
+onset = None if onset_index is None else {"time_s": float(times[onset_index]), "head_m": rows[onset_index]["head_m"],
+                                          "criterion": "kinetic energy of the solid grows at each of the next 5 records and by ≥ 10× (yade_mpm.analysis.kinetic_onset)"}
+runout = yade_mpm.analysis.toe_runout(start_positions, solid.pos, toe_x=float(start_positions[:, 0].max()), base_band=2 * CELL)
+deposit_x, deposit_z = yade_mpm.analysis.deposit_profile(solid.pos, np.arange(0, SCENE.flume_length + spacing, 2 * spacing), half_height=0.5 * spacing)
+mobilised, mobilised_fraction = yade_mpm.analysis.mobilised_volume(start_positions, solid.pos, solid.volume, displacement=spacing)
+
 stored, residual = mass_balance()
 summary = {
     "mode": "quick" if args.quick else "full",
@@ -291,6 +303,16 @@ summary = {
                                               "criterion": "mean displacement of the lower slope face > %.4f m" % FAILURE_DISPLACEMENT},
     "sliding_surface": sliding,
     "limit_equilibrium": lem_summary,
+    "onset": onset,
+    "onset_head_m": None if onset is None else onset["head_m"],
+    "lem_onset_head_m": lem_summary["lem_onset_head_m"],
+    "runout_m": runout,
+    "mobilised_volume_m3": mobilised,
+    "mobilised_fraction": mobilised_fraction,
+    "deposit_profile": {"x_m": deposit_x.tolist(), "z_m": [None if np.isnan(z) else float(z) for z in deposit_z]},
+    "injected_kg": engine.injectedWaterMass,
+    "removed_kg": engine.removedWaterMass,
+    "relative_residual": residual,
     "water_mass_balance": {"initial_kg": initial_water, "injected_kg": engine.injectedWaterMass, "removed_kg": engine.removedWaterMass,
                            "stored_kg": stored, "relative_residual": residual},
 }
@@ -385,3 +407,4 @@ fig.tight_layout()
 fig.savefig(os.path.join(OUT, "time_series.png"), dpi=110)
 print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "stopped_unstable", "failure", "sliding_surface", "water_mass_balance", "stable_before_rise")}, indent=2))
 print(json.dumps({k: lem_summary[k] for k in ("lem_onset_head_m", "factors")}))
+print(json.dumps({k: summary[k] for k in ("onset", "runout_m", "mobilised_fraction")}))

@@ -34,7 +34,7 @@ _yade_mpm.registerClasses(yade.wrapper)
 self_test(_yade_mpm, yade.wrapper, yade.wrapper.Omega())
 
 from yade.wrapper import MpmHdf5Recorder, MpmSoilMat, MpmSolidPoints, MpmTwoPhaseEngine, MpmWaterMat, MpmWaterPoints  # noqa: E402
-from . import _scenefiles, analytical, builders, calibrate, dem, monitor, results, sandpile, slope_stability  # noqa: E402
+from . import _scenefiles, analysis, analytical, builders, calibrate, dem, monitor, results, sandpile, slope_stability  # noqa: E402
 from .builders import apply_undrained_load, saturated_block, saturated_points  # noqa: E402
 from .monitor import progress  # noqa: E402
 

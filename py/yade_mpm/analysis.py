@@ -1,0 +1,65 @@
+"""Post-processing of a slope run from its point arrays and time series (numpy only): the onset of
+failure by a kinematic criterion, the run-out of the toe, the deposit profile and the mobilised
+volume (doc/sandpile.md). Each function takes plain arrays, so it works on a live run, on
+`yade_mpm.results.read` records and on synthetic data alike.
+"""
+import numpy as np
+
+
+def kinetic_energy(masses, velocities):
+    """Σ ½ m |v|² [J] of a point set (masses [kg], velocities N×3 [m s⁻¹])."""
+    v = np.asarray(velocities, dtype=float)
+    return 0.5 * float(np.sum(np.asarray(masses, dtype=float) * np.einsum("ij,ij->i", v, v)))
+
+
+def kinetic_onset(times, energies, sustain=5, growth=10.0):
+    """Onset of failure: the first record from which the kinetic energy grows at every one of the
+    next `sustain` records (≥ 1) and ends at least `growth` times (> 1) higher — sustained
+    acceleration, not a displacement threshold. A settling or vibrating body, whose energy falls
+    or oscillates, has none. Returns the index of that record, or None."""
+    if not (int(sustain) >= 1):
+        raise ValueError("sustain = %r records is outside the valid range [1, inf)" % (sustain,))
+    if not growth > 1:
+        raise ValueError("growth = %r is outside the valid range (1, inf)" % (growth,))
+    e = np.asarray(energies, dtype=float)
+    if np.asarray(times).shape != e.shape:
+        raise ValueError("times and energies must have the same length")
+    for i in range(len(e) - int(sustain)):
+        window = e[i:i + int(sustain) + 1]
+        if window[0] > 0 and np.all(np.diff(window) > 0) and window[-1] >= growth * window[0]:
+            return i
+    return None
+
+
+def toe_runout(start_positions, positions, toe_x, base_band):
+    """Advance of the toe front [m]: the largest x of the solid points within `base_band` [m] of
+    the base (z ≤ base_band) now, less the toe's x at the start (`toe_x`); 0 if none moved past it."""
+    pos = np.asarray(positions, dtype=float)
+    near_base = pos[:, 2] <= base_band
+    if not near_base.any():
+        return 0.0
+    return max(0.0, float(pos[near_base, 0].max()) - float(toe_x))
+
+
+def deposit_profile(positions, bin_edges, half_height=0.0):
+    """Height of the deposit per x bin [m]: the highest solid point of each bin plus
+    `half_height` (half a point spacing puts it on the points' domain edge); NaN where empty.
+    Returns (bin centres, heights)."""
+    pos = np.asarray(positions, dtype=float)
+    edges = np.asarray(bin_edges, dtype=float)
+    index = np.digitize(pos[:, 0], edges) - 1
+    heights = np.full(len(edges) - 1, np.nan)
+    inside = (index >= 0) & (index < len(heights))
+    for i in np.unique(index[inside]):
+        heights[i] = pos[index == i, 2].max() + half_height
+    return 0.5 * (edges[:-1] + edges[1:]), heights
+
+
+def mobilised_volume(start_positions, positions, volumes, displacement):
+    """Volume [m³] (and its share of the total) of the points that moved more than `displacement`
+    [m] since the start — e.g. one point spacing, below which a point has not left its place.
+    Returns (volume, fraction)."""
+    moved = np.linalg.norm(np.asarray(positions, dtype=float) - np.asarray(start_positions, dtype=float), axis=1) > displacement
+    v = np.asarray(volumes, dtype=float)
+    total = float(v.sum())
+    return float(v[moved].sum()), (float(v[moved].sum()) / total if total > 0 else 0.0)
