@@ -58,12 +58,14 @@ parser.add_argument("--inertia-scale", type=float, default=1.0, help="inertia sc
                                                                      "by itself when the pile accelerates (eq. 4.8c)")
 parser.add_argument("--ramp-time", type=float, help="duration of the head rise [s] (default the scene's 0.3 s)")
 parser.add_argument("--hold-time", type=float, help="head held at the crest after the rise [s] (default the scene's 0.35 s)")
+parser.add_argument("--head-start", type=float, help="inflow water level at the start, also the pile's starting water table [m] (default the scene's 0.03 m)")
 args = parser.parse_args(sys.argv[1:])
 
 SCENE = sandpile.DEFAULT
-if args.ramp_time is not None or args.hold_time is not None:
+if args.ramp_time is not None or args.hold_time is not None or args.head_start is not None:
     SCENE = dataclasses.replace(SCENE, head_ramp_time=SCENE.head_ramp_time if args.ramp_time is None else args.ramp_time,
-                                hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time)
+                                hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time,
+                                head_start=SCENE.head_start if args.head_start is None else args.head_start)
 SEMI_IMPLICIT = args.scheme == "semi-implicit"
 GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
 G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]
@@ -166,7 +168,8 @@ initial_water = float(fluid.mass.sum())
 
 def mass_balance():
     stored = float(fluid.mass.sum())
-    residual = (stored + engine.removedWaterMass - initial_water - engine.injectedWaterMass) / initial_water
+    supplied = initial_water + engine.injectedWaterMass  # all the water the run ever had [kg]
+    residual = (stored + engine.removedWaterMass - supplied) / supplied if supplied > 0 else 0.0
     return stored, residual
 
 
