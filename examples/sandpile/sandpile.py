@@ -202,7 +202,7 @@ while O.time < DURATION - 1e-12:
     record += 1
     stored, residual = mass_balance()
     if not abs(residual) < BALANCE_TOLERANCE:
-        raise RuntimeError("water mass balance failed at t = %.4f s: (stored + removed − initial − injected)/initial = %.3e"
+        raise RuntimeError("water mass balance failed at t = %.4f s: (stored + removed − initial − injected)/(initial + injected) = %.3e"
                            % (O.time, residual))
     speed = np.linalg.norm(solid.vel, axis=1)
     row = {"time_s": O.time, "head_m": SCENE.head(O.time), "toe_displacement_m": toe_displacement(), "face_displacement_m": face_displacement(),
