@@ -128,7 +128,7 @@ public:
 	// skeleton's inertial-force ratio of the last step (eq. 4.8c) [-].
 	long                                                inertiaScaleReleaseStep() const { return inertiaReleaseStep_; }
 	Real                                                lastInertiaRatio() const { return lastInertiaRatio_; }
-	// τ = ρsat κ/μw, the shortest over the solid sets [s] (inf without water): the time in which the
+	// τ = α ρsat κ/μw (α the inertia scale in force), the shortest over the solid sets [s] (inf without water): the time in which the
 	// drag relaxes the mixture's relative flow. The semi-implicit projection's stabilisation drains
 	// a consolidating soil spuriously in proportion to Δt/τ (theory.md §8.7b: Terzaghi at Δt/τ = 1.3,
 	// 13, 134, 1340 is 0.9%, 6%, 21%, 40% of p0 off without defect corrections).

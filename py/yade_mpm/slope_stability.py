@@ -125,14 +125,6 @@ class Slices:
     def base_length(self):
         return self.width / np.cos(self.alpha)
 
-    def volume(self, section):
-        """Area of the sliding mass per unit width [m²]."""
-        return float(np.sum(self.width * (section_surface_mirrored(section, self.x) - self.z)))
-
-
-def section_surface_mirrored(section, x):
-    return section.surface(section.direction * x)
-
 
 def slices_of_surface(section, slip_x, slip_z, count=40):
     """Slices of a slip surface given as a polyline (slip_x increasing, in the section's frame)
@@ -214,7 +206,7 @@ def bishop_simplified(slices, tolerance=1e-8, max_iterations=200):
     """Bishop's simplified factor of safety (moments about slices.centre; horizontal interslice
     forces). For a circle: F = Σ (c l + N′ tan φ) R / Σ W (x_c − x), N′ = [W − u b − c l sin α / F]/m_α,
     m_α = cos α + sin α tan φ / F. Returns F (inf where nothing drives the mass, nan where no
-    positive F balances it)."""
+    positive F balances it, where m_α < 0.2 on a slice, or where the iteration does not converge)."""
     if slices.centre is None:
         raise ValueError("bishop_simplified needs a moment centre (a circular surface); use spencer for other surfaces")
     xc, zc = slices.centre
@@ -230,9 +222,10 @@ def bishop_simplified(slices, tolerance=1e-8, max_iterations=200):
     F = 1.0
     for _ in range(max_iterations):
         m_alpha = np.cos(a) + np.sin(a) * t / F
-        if np.any(m_alpha <= 0.2 * np.cos(a)):
-            # m_α near 0: the steep exit end where the method is known to fail (Whitman & Bailey 1967)
-            m_alpha = np.maximum(m_alpha, 0.2 * np.cos(a))
+        if np.any(m_alpha < 0.2):
+            # m_α < 0.2 at a steep exit: the normal force there is unreliable and the method is known
+            # to fail (Whitman & Bailey 1967, who recommend discarding such surfaces): no admissible F
+            return math.nan
         N_eff = (W - u * b - c * l * np.sin(a) / F) / m_alpha
         resisting = np.sum((c * l + N_eff * t) * shear_arm)
         F_new = resisting / (driving + np.sum((N_eff + u * l) * normal_arm))
@@ -241,7 +234,7 @@ def bishop_simplified(slices, tolerance=1e-8, max_iterations=200):
         if abs(F_new - F) <= tolerance * abs(F):
             return float(F_new)
         F = F_new
-    return float(F)
+    return math.nan  # no convergence: no F is reported for this surface
 
 
 def _spencer_q(slices, F, theta):

@@ -183,7 +183,9 @@ TEST(TerzaghiSemiImplicit, RealWaterAtTwentyTimesTheExplicitStep)
 // p0 at Tv = 0.02, 0.05, 0.1 with α = 100 in 2489 steps, 0.27%, 0.06%, 0.15% with α = 1 in 24879;
 // U within 2e-4 of the series in both. (Without the corrections this slow drainage shows the
 // stabilised projection's leak of §8.7b, growing with the number of steps: α = 1 reads 21%, 15%, 11%
-// off, α = 100 6.3%, 3.1%, 2.2%.) Bound: 1% of p0, U within 0.005, a tenth of the steps.
+// off, α = 100 6.3%, 3.1%, 2.2%.) Bound: 1% of p0, U within 0.005, a tenth of the steps. The pressure
+// mobility must take the water's inertia α ρw too (eq. 8.5 under eq. 4.8b): with the true ρw the same
+// run reads 1.9%, 1.2%, 0.86% (checked).
 TEST(InertiaScaling, ConsolidationKeepsTerzaghisSeriesWithATenthOfTheSteps)
 {
 	TerzaghiColumn scaled(0.05, 2.2e9, TimeScheme::SemiImplicit, ShapeFunction::UGimp, 1, false, 1e-5, 100, 2);
