@@ -103,7 +103,7 @@ void forEachDrainedFaceTraction(const GridGeometry& grid, const BoundaryConditio
 	const Real h = grid.cellSize;
 	for (int face = 0; face < faceCount; ++face) {
 		const WallConditions& wall = bcs.walls[face];
-		if (wall.water != WaterWall::Drained || (wall.drainedPressure == 0 && wall.waterTable == -std::numeric_limits<Real>::infinity())) continue;
+		if (wall.water != WaterWall::Drained || (wall.drainedPressure == 0 && wall.waterTable == -std::numeric_limits<Real>::infinity() && !bcs.submerged())) continue;
 		const int  axis = face / 2, a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
 		const bool upperFace = face % 2 == 1;
 		Vec3       inward    = Vec3::Zero();
@@ -116,7 +116,7 @@ void forEachDrainedFaceTraction(const GridGeometry& grid, const BoundaryConditio
 			Vec3 centroid = grid.nodePosition(idx[0], idx[1], idx[2]);
 			centroid[a1] += centroidShift(a1, idx[a1]);
 			centroid[a2] += centroidShift(a2, idx[a2]);
-			apply(I, wall.drainedPressureAt(centroid, gravity, waterDensity) * area * inward);
+			apply(I, wall.drainedPressureAt(centroid, gravity, waterDensity, bcs.stillWaterLevel) * area * inward);
 		});
 	}
 }
@@ -157,7 +157,7 @@ void applyDrainedFaces(const GridGeometry& grid, const BoundaryConditions& bcs, 
 			// has moved half a spacing off; the next layer (three half-lengths in) never is one.
 			const Real x = points.position[p][axis], l = points.halfLength[p][axis];
 			const bool facePoint = upperFace ? x >= upper[axis] - 2 * l : x <= lower[axis] + 2 * l;
-			if (facePoint) points.porePressure[p] = wall.drainedPressureAt(points.position[p], gravity, waterDensity);
+			if (facePoint) points.porePressure[p] = wall.drainedPressureAt(points.position[p], gravity, waterDensity, bcs.stillWaterLevel);
 		}
 	}
 }

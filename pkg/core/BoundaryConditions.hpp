@@ -51,13 +51,16 @@ struct WallConditions {
 		return g == 0 || waterTable == -std::numeric_limits<Real>::infinity() || -gravity.dot(x) / g < waterTable;
 	}
 
-	// p̄ at position x (theory.md eq. 2.1)
-	Real drainedPressureAt(const Vec3& x, const Vec3& gravity, Real waterDensity) const
+	// p̄ at position x (theory.md eq. 2.1); with a still water level (eq. 1.9, finite
+	// `stillWaterLevel`) the excess over that water's hydrostatic pressure ρw |g| (level − z)
+	Real drainedPressureAt(const Vec3& x, const Vec3& gravity, Real waterDensity, Real stillWaterLevel) const
 	{
 		const Real g = gravity.norm();
-		if (g == 0 || waterTable == -std::numeric_limits<Real>::infinity()) return drainedPressure;
+		if (g == 0) return drainedPressure;
 		const Real elevation = -gravity.dot(x) / g;
-		return drainedPressure + waterDensity * g * std::max<Real>(0, waterTable - elevation);
+		const Real table     = waterTable == -std::numeric_limits<Real>::infinity() ? 0 : waterDensity * g * std::max<Real>(0, waterTable - elevation);
+		const Real still     = std::isfinite(stillWaterLevel) ? waterDensity * g * (stillWaterLevel - elevation) : 0;
+		return drainedPressure + table - still;
 	}
 };
 
@@ -67,6 +70,12 @@ struct BoundaryConditions {
 	// Per axis: the domain repeats along it (theory.md §2.7), points leaving through one face enter
 	// through the other and the two faces are no walls (their conditions must stay the defaults).
 	std::array<bool, 3> periodic { false, false, false };
+	// Elevation [m] of still free water the whole soil lies in (theory.md eq. 1.9); −∞: none. When
+	// finite, pore pressures are excess pressures over that water's hydrostatic pressure, the water
+	// weighs nothing and the grains weigh (ρs − ρw) g: the hydrostatic part balances exactly, so a
+	// submerged surface is an excess-pressure free surface (p = 0) and needs no load from the water.
+	Real stillWaterLevel = -std::numeric_limits<Real>::infinity();
+	bool submerged() const { return std::isfinite(stillWaterLevel); }
 
 	// Throws InvalidParameter naming the face and the condition if a face of a periodic axis
 	// carries any wall condition (it would be silently ignored).

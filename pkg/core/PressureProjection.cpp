@@ -66,7 +66,7 @@ namespace stages {
 					const WallConditions& wall = bcs.walls[2 * axis + side];
 					if (wall.water == WaterWall::Drained) {
 						drained = true;
-						value   = wall.drainedPressureAt(grid.nodePosition(idx[0], idx[1], idx[2]), gravity, waterDensity);
+						value   = wall.drainedPressureAt(grid.nodePosition(idx[0], idx[1], idx[2]), gravity, waterDensity, bcs.stillWaterLevel);
 					} else if (wall.water == WaterWall::Free) open = true;
 				}
 			}

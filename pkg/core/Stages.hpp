@@ -94,9 +94,10 @@ namespace stages {
 
 	// Step 2 (theory.md eqs. 4.1–4.3): solid mass, momentum, effective-stress force, weight,
 	// point loads, mixture and grain volumes, drag coefficient (none without water: `water` null).
+	// `submerged` (eq. 1.9, wet only): the grains' weight is the buoyant one, m (1 − ρw/ρs) g.
 	template <class Kernel>
 	void mapSolidToGrid(const GridGeometry& grid, const std::vector<SolidSet>& sets, const WaterParameters* water, const Vec3& gravity,
-	                    GridFields& fields, ScatterWorkspace& workspace);
+	                    GridFields& fields, ScatterWorkspace& workspace, bool submerged = false);
 
 	// Nodal porosity n_I = 1 − Σ S m/ρs / Σ S V (theory.md eq. 4.4); 1 where there is no solid.
 	void computeNodalPorosity(GridFields& fields);
@@ -107,10 +108,11 @@ namespace stages {
 	// Steps 3–4 (theory.md eqs. 4.5–4.7): porosity at water points from the nodal field, then water
 	// mass, momentum, weight, −n∇p force (incl. the porosity-gradient term) and the pressure force.
 	// `pressureForces` false leaves the pore-pressure forces out (the semi-implicit predictor: the
-	// projection supplies them from p^{n+1}, theory.md §8.3).
+	// projection supplies them from p^{n+1}, theory.md §8.3). `submerged` (eq. 1.9): the water
+	// weighs nothing (its weight balances the still water's hydrostatic gradient).
 	template <class Kernel>
 	void mapWaterToGrid(const GridGeometry& grid, std::vector<WaterPointSet*>& sets, const Vec3& gravity, GridFields& fields,
-	                    ScatterWorkspace& workspace, bool pressureForces = true);
+	                    ScatterWorkspace& workspace, bool pressureForces = true, bool submerged = false);
 
 	// Step 5: v_I = P_I / m_I for nodes above the mass tolerance, else 0.
 	void computeNodalVelocities(GridFields& fields, Real solidMassTolerance, Real waterMassTolerance);

@@ -38,7 +38,7 @@ namespace stages {
 
 	template <class Kernel>
 	void mapSolidToGrid(const GridGeometry& grid, const std::vector<SolidSet>& sets, const WaterParameters* water, const Vec3& gravity,
-	                    GridFields& fields, ScatterWorkspace& workspace)
+	                    GridFields& fields, ScatterWorkspace& workspace, bool submerged)
 	{
 		for (const SolidSet& set : sets) {
 			const SolidPointSet& P         = *set.points;
@@ -46,12 +46,15 @@ namespace stages {
 			const Real           dragScale = water ? water->viscosity / set.soil.intrinsicPermeability : 0; // μw/κ0; no drag when dry
 			const Real           n0        = set.soil.porosity;
 			const bool           kc        = set.kozenyCarman;
+			// eq. 1.9: in still water the grains weigh (ρs − ρw) g, the water's weight and the
+			// hydrostatic pressure's gradient cancel
+			const Vec3 bodyForce = water && submerged ? Vec3((1 - water->density / set.soil.density) * gravity) : gravity;
 			scatter(fields.solid, workspace.solid, P.size(), [&](std::size_t p, SolidNode* nodes) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
 				const Real   m = P.mass[p], V = P.volume[p], n = P.porosity[p];
 				const Mat3   sigma   = voigtToMatrix(P.effectiveStress[p]);
-				const Vec3   weight  = m * gravity + P.externalForce[p];
+				const Vec3   weight  = m * bodyForce + P.externalForce[p];
 				const Vec3   mv      = m * P.velocity[p];
 				const Real   Q       = V * n * n * dragScale / (kc ? kozenyCarmanRatio(n, n0) : 1.0);
 				const Real   Vgrain  = m * invGrain;
@@ -96,8 +99,8 @@ namespace stages {
 	}
 
 	template <class Kernel>
-	void mapWaterToGrid(const GridGeometry& grid, std::vector<WaterPointSet*>& sets, const Vec3& gravity, GridFields& fields, ScatterWorkspace& workspace,
-	                    bool pressureForces)
+	void mapWaterToGrid(const GridGeometry& grid, std::vector<WaterPointSet*>& sets, const Vec3& gravity, GridFields& fields,
+	                    ScatterWorkspace& workspace, bool pressureForces, bool submerged)
 	{
 		const std::vector<Real>& nodalPorosity = fields.porosity;
 		for (WaterPointSet* set : sets) {
@@ -118,7 +121,7 @@ namespace stages {
 				n              = soil ? std::clamp<Real>(n, minimumInterpolatedPorosity, 1) : 1;
 				P.porosity[p]  = n;
 				const Real m = P.mass[p], V = P.volume[p], pressure = pressureForces ? P.porePressure[p] : 0;
-				const Vec3 weight = m * gravity;
+				const Vec3 weight = submerged ? Vec3::Zero() : Vec3(m * gravity); // eq. 1.9
 				const Vec3 mv     = m * P.velocity[p];
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 					WaterNode& node = nodes[I];
@@ -232,8 +235,8 @@ namespace stages {
 	}
 
 #define MPM_INSTANTIATE(K) \
-	template void mapSolidToGrid<K>(const GridGeometry&, const std::vector<SolidSet>&, const WaterParameters*, const Vec3&, GridFields&, ScatterWorkspace&); \
-	template void mapWaterToGrid<K>(const GridGeometry&, std::vector<WaterPointSet*>&, const Vec3&, GridFields&, ScatterWorkspace&, bool); \
+	template void mapSolidToGrid<K>(const GridGeometry&, const std::vector<SolidSet>&, const WaterParameters*, const Vec3&, GridFields&, ScatterWorkspace&, bool); \
+	template void mapWaterToGrid<K>(const GridGeometry&, std::vector<WaterPointSet*>&, const Vec3&, GridFields&, ScatterWorkspace&, bool, bool); \
 	template void remapVelocities<K>(const GridGeometry&, const std::vector<const MaterialPointSet*>&, Real, const ConstrainedNodes&, bool, std::vector<Vec3>&, ScatterWorkspace&); \
 	template void computeVelocityGradients<K>(const GridGeometry&, const std::vector<Vec3>&, const MaterialPointSet&, std::vector<Mat3>&);
 

@@ -130,6 +130,8 @@ TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& setti
 	inertiaScale_ = settings_.inertiaScale;
 	domain_.boundaries.requireFreePeriodicFaces();
 	domain_.boundaries.requireValidPlate();
+	const Real level = domain_.boundaries.stillWaterLevel;
+	if (!(std::isfinite(level) || level == -inf)) throwOutOfRange("stillWaterLevel", level, "m", "(-inf, inf): finite, or -inf for no still water");
 	for (int f = 0; f < faceCount; ++f)
 		if (domain_.boundaries.walls[f].inflow && domain_.boundaries.walls[f].water != WaterWall::Drained)
 			throw InvalidParameter(std::string("the inflow face ") + faceName(f) + " must be a drained water wall");
@@ -184,6 +186,24 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 						throw InvalidParameter(std::string("face ") + faceName(f) + ": solidWalls 'free' with waterWalls 'impermeable' (an undrained face over a free skeleton, which " +
 						                       set.name + " reaches) is not supported by scheme = 'semi-implicit' yet (its projection is unstable there, theory.md §8 Open): use scheme = 'explicit', a 'drained' or 'free' water wall, or a skeleton wall ('slip', 'fixed', 'plate')");
 		}
+	// eq. 1.9 holds below the still water only: soil above it would weigh as if submerged
+	const Real g = settings_.gravity.norm();
+	if (domain_.boundaries.submerged() && g > 0) {
+		auto requireBelowLevel = [&](const MaterialPointSet& P, const std::string& name) {
+			for (std::size_t p = 0; p < P.size(); ++p) {
+				const Real elevation = -settings_.gravity.dot(P.position[p]) / g;
+				if (elevation > domain_.boundaries.stillWaterLevel) {
+					std::ostringstream what;
+					what << "stillWaterLevel = " << domain_.boundaries.stillWaterLevel << " m lies below " << name << ".position[" << p << "] (elevation " << elevation
+					     << " m): the excess-pressure formulation (theory.md eq. 1.9) needs every point under the still water; raise the level above the soil's top or leave it at -inf";
+					throw InvalidParameter(what.str());
+				}
+			}
+		};
+		for (const SolidSet& set : solids) requireBelowLevel(*set.points, set.name);
+		for (std::size_t w = 0; w < waters.size(); ++w) requireBelowLevel(*waters[w], w < waterNames.size() ? waterNames[w] : "water set " + std::to_string(w));
+		if (waters.empty()) throw InvalidParameter("stillWaterLevel is finite but the scene has no water points: the excess-pressure formulation (theory.md eq. 1.9) is for saturated soil");
+	}
 	solids_ = std::move(solids);
 	waters_ = std::move(waters);
 	water_  = water;
@@ -389,14 +409,14 @@ template <class Kernel> void TwoPhaseSolver::mapPointsToGrid(bool wet)
 	const Vec3& g = settings_.gravity;
 	{
 		StageTimer t(stageSeconds_, Stage::MapSolidToGrid);
-		mapSolidToGrid<Kernel>(grid_, solids_, wet ? &water_ : nullptr, g, fields_, workspace_);
+		mapSolidToGrid<Kernel>(grid_, solids_, wet ? &water_ : nullptr, g, fields_, workspace_, domain_.boundaries.submerged());
 		addFaceTractions(grid_, domain_.boundaries, solidMassTolerance_, fields_); // eq. 2.8
 		if (wet) computeNodalPorosity(fields_);
 	}
 	if (!wet) return;
 	StageTimer t(stageSeconds_, Stage::MapWaterToGrid);
 	const bool explicitScheme = settings_.scheme == TimeScheme::Explicit;
-	mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_, explicitScheme);
+	mapWaterToGrid<Kernel>(grid_, waters_, g, fields_, workspace_, explicitScheme, domain_.boundaries.submerged());
 	limitDragToWetSupport(grid_, domain_.boundaries, fields_); // eq. 4.7b
 	// semi-implicit: these are pore-pressure forces too, applied with the others in the corrector
 	if (explicitScheme) addDrainedFaceTractions(grid_, domain_.boundaries, g, water_.density, waterMassTolerance_, fields_);
@@ -736,7 +756,7 @@ void TwoPhaseSolver::injectInflowingWater()
 				if (!wall.belowWaterTable(x, settings_.gravity) || x[a1] > upper[a1] || x[a2] > upper[a2]) continue;
 				const std::size_t q = w->appendCopyOf(static_cast<std::size_t>(neighbour));
 				w->position[q]      = x; // with its neighbour's velocity, as a buffer takes its row's
-				w->porePressure[q]  = wall.drainedPressureAt(x, settings_.gravity, water_.density);
+				w->porePressure[q]  = wall.drainedPressureAt(x, settings_.gravity, water_.density, domain_.boundaries.stillWaterLevel);
 				injectedWaterMass_ += w->mass[q];
 				inflowNearest_[row] = static_cast<long>(q);
 				inflowDepth_[row]   = 0.5 * s;
@@ -764,7 +784,7 @@ void TwoPhaseSolver::injectInflowingWater()
 					w->halfLength[q]    = w->halfLength[outer];
 					w->mass[q]          = w->mass[outer];
 					w->volume[q]        = w->volume[outer];
-					w->porePressure[q]  = wall.drainedPressureAt(w->position[q], settings_.gravity, water_.density);
+					w->porePressure[q]  = wall.drainedPressureAt(w->position[q], settings_.gravity, water_.density, domain_.boundaries.stillWaterLevel);
 					injectedWaterMass_ += w->mass[q] - before;
 					before = 0;
 					b      = -1;
@@ -777,7 +797,7 @@ void TwoPhaseSolver::injectInflowingWater()
 				w->halfLength[q][axis] = 0.5 * gap;
 				w->mass[q]            = gap / s * w->mass[outer];
 				w->volume[q]          = gap / s * w->volume[outer];
-				w->porePressure[q]    = wall.drainedPressureAt(w->position[q], settings_.gravity, water_.density);
+				w->porePressure[q]    = wall.drainedPressureAt(w->position[q], settings_.gravity, water_.density, domain_.boundaries.stillWaterLevel);
 				const Real added      = w->mass[q] - before;
 				if (added >= 0) injectedWaterMass_ += added;
 				else removedWaterMass_ -= added;

@@ -1,0 +1,152 @@
+// Soil submerged in still water (doc/theory.md eq. 1.9): the pore pressure is the excess over the
+// still water's hydrostatic pressure, the water weighs nothing and the grains weigh (ρs − ρw) g.
+// A column with a free top surface under 0.3 m of still water, semi-implicit, real water.
+#include "core/Errors.hpp"
+#include "core/TwoPhaseSolver.hpp"
+#include "support/AnalyticalSolutions.hpp"
+#include "support/Fixtures.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace {
+
+using namespace mpm;
+
+constexpr double g = 9.81, H = 1.0, h = 0.05, k = 1e-2; // column height, cell, hydraulic conductivity [m s⁻¹]
+constexpr double waterAboveSoil = 0.3;                  // depth of the still water over the soil's top [m]
+
+struct SubmergedColumn {
+	SoilParameters  soil;
+	WaterParameters water; // real water
+	SolidPointSet   solid;
+	WaterPointSet   fluid;
+	std::unique_ptr<TwoPhaseSolver> solver;
+	double          removedBefore = 0;
+
+	// `excessHead` [m]: the base is drained to a reservoir that much above the still water (0: a
+	// fixed impermeable base); the soil's top is its own free surface, two cells below the domain's top
+	double          height;
+
+	explicit SubmergedColumn(double excessHead, double soilHeight = H)
+	        : height(soilHeight)
+	{
+		soil.porosity              = 0.4;
+		soil.intrinsicPermeability = k * water.viscosity / (water.density * g);
+		const auto l               = fixtures::lattice(Vec3::Zero(), Vec3(h, h, height), h, 2);
+		solid                      = fixtures::solidLattice(l, soil.porosity, soil.density);
+		fluid                      = fixtures::waterLattice(l, soil.porosity, water.density);
+		// buoyant geostatic state; the excess pore pressure is 0 in still water
+		const double k0 = soil.poissonRatio / (1 - soil.poissonRatio);
+		for (std::size_t p = 0; p < solid.size(); ++p) {
+			const double sz = -buoyantUnitWeight() * (height - solid.position[p].z());
+			solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
+		}
+		Domain d = fixtures::columnDomain(Vec3(h, h, H + 2 * h), h);
+		if (height > H) throw std::invalid_argument("the column's height must be at most H");
+		d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Free };
+		if (excessHead > 0) fixtures::reservoirFace(d, Face::ZMin, height + waterAboveSoil + excessHead, false, SolidWall::Fixed);
+		d.boundaries.stillWaterLevel = height + waterAboveSoil;
+		d.removeFreeWater            = true; // seepage that leaves the soil's top joins the still water
+		SolverSettings s;
+		s.gravity = Vec3(0, 0, -g);
+		solver    = std::make_unique<TwoPhaseSolver>(d, s);
+		solver->setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	}
+	double buoyantUnitWeight() const { return (1 - soil.porosity) * (soil.density - water.density) * g; }
+	void   run(double duration)
+	{
+		const double dt    = 0.5 * solver->timeStepLimits().critical;
+		const long   steps = static_cast<long>(std::ceil(duration / dt));
+		for (long i = 0; i < steps; ++i) solver->step(duration / steps);
+	}
+};
+
+// At rest: with no excess head nothing moves and the excess pressure stays 0 — the hydrostatic
+// pressure of the still water and its weight cancel exactly in eq. 1.9; the skeleton carries its
+// buoyant weight. The soil's top lies half a cell above a node plane, where the total-pressure
+// form holds the surface node at p = 0 half a cell above the water and the column does not stay
+// at rest (tests/yade/test_physics.py, the strict xfail of the saturated surface between node planes).
+TEST(StillWater, SubmergedColumnStaysAtRestWithNoExcessPressure)
+{
+	const double    height = H - h / 2;
+	SubmergedColumn c(0, height);
+	c.run(0.05);
+	double pMax = 0, vMax = 0, sigmaError = 0;
+	for (std::size_t p = 0; p < c.fluid.size(); ++p) {
+		pMax = std::max(pMax, std::abs(c.fluid.porePressure[p]));
+		vMax = std::max({ vMax, c.fluid.velocity[p].norm(), c.solid.velocity[p].norm() });
+		sigmaError = std::max(sigmaError, std::abs(c.solid.effectiveStress[p][2] + c.buoyantUnitWeight() * (height - c.solid.position[p].z())));
+	}
+	const double gammaW = c.water.density * g;
+	std::printf("submerged column at rest: max |p| %.2e γw H, max |v| %.2e m/s, max σ′zz error %.2e γ′H\n", pMax / (gammaW * H), vMax,
+	            sigmaError / (c.buoyantUnitWeight() * H));
+	EXPECT_LT(pMax, 1e-9 * gammaW * H);
+	EXPECT_LT(vMax, 1e-9);
+	EXPECT_LT(sigmaError, 1e-6 * c.buoyantUnitWeight() * H);
+}
+
+// Upward seepage into the still water: the base drained to a reservoir Δh above the still water's
+// level (given as a total head, converted to the excess Δh γw by the face), the soil's top a free
+// surface under the water. At the steady state the excess pressure falls linearly, p = i γw z with
+// i = Δh/H, Darcy's flux is k i, and σ′zz = −(γ′ − i γw)(H − z).
+TEST(StillWater, UpwardSeepageIntoStillWaterCarriesDarcysFlux)
+{
+	const double   gammaW = WaterParameters {}.density * g;
+	SubmergedColumn probe(0);
+	const double   iCritical = probe.buoyantUnitWeight() / gammaW, i = 0.8 * iCritical, dh = i * H;
+	SubmergedColumn c(dh);
+	const double   cv = analytical::consolidationCoefficient(c.soil.intrinsicPermeability / c.water.viscosity, c.soil.constrainedModulus(), c.soil.porosity,
+	                                                         c.water.bulkModulus);
+	c.run(2.5 * H * H / cv); // Tv = 2.5: within 0.1% of the steady state
+	double pError = 0, sigmaError = 0, flux = 0;
+	int    count = 0;
+	for (std::size_t p = 0; p < c.fluid.size(); ++p) {
+		const double z = c.fluid.position[p].z();
+		if (z < 2 * h || z > H - 2 * h) continue; // a boundary layer of the drained base and the surface
+		pError = std::max(pError, std::abs(c.fluid.porePressure[p] - i * gammaW * (H - z)));
+		flux += c.soil.porosity * (c.fluid.velocity[p].z() - c.solid.velocity[p].z());
+		++count;
+	}
+	for (std::size_t p = 0; p < c.solid.size(); ++p) {
+		const double z = c.solid.position[p].z();
+		if (z < 2 * h || z > H - 2 * h) continue;
+		sigmaError = std::max(sigmaError, std::abs(c.solid.effectiveStress[p][2] + (c.buoyantUnitWeight() - i * gammaW) * (H - z)));
+	}
+	const double fluxError = flux / count / (k * i) - 1;
+	std::printf("upward seepage into still water, i = %.3f: max |p − i γw (H − z)| %.4f of i γw H, flux %+.4f of k i, max σ′zz error %.4f of γ′H, "
+	            "removed %.3e kg\n",
+	            i, pError / (i * gammaW * H), fluxError, sigmaError / (c.buoyantUnitWeight() * H), c.solver->removedWaterMass());
+	EXPECT_LT(pError, 0.02 * i * gammaW * H);
+	EXPECT_LT(std::abs(fluxError), 0.02);
+	EXPECT_LT(sigmaError, 0.02 * c.buoyantUnitWeight() * H);
+}
+
+// Input checks (before any work): a level that is not a finite elevation, and soil above the level.
+TEST(StillWater, RefusesALevelBelowTheSoilAndANonFiniteOne)
+{
+	SoilParameters  soil;
+	WaterParameters water;
+	const auto      l     = fixtures::lattice(Vec3::Zero(), Vec3(h, h, H), h, 2);
+	SolidPointSet   solid = fixtures::solidLattice(l, soil.porosity, soil.density);
+	WaterPointSet   fluid = fixtures::waterLattice(l, soil.porosity, water.density);
+	Domain          d     = fixtures::columnDomain(Vec3(h, h, H), h);
+	SolverSettings  s;
+	s.gravity                    = Vec3(0, 0, -g);
+	d.boundaries.stillWaterLevel = std::numeric_limits<double>::quiet_NaN();
+	EXPECT_THROW(TwoPhaseSolver solver(d, s), InvalidParameter);
+	d.boundaries.stillWaterLevel = 0.5 * H;
+	TwoPhaseSolver accepted(d, s);
+	try {
+		accepted.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+		FAIL() << "soil above the still water was accepted";
+	} catch (const InvalidParameter& e) {
+		EXPECT_NE(std::string(e.what()).find("stillWaterLevel = 0.5 m"), std::string::npos) << e.what();
+	}
+}
+
+} // namespace
