@@ -58,10 +58,16 @@ parser.add_argument("--inertia-scale", type=float, default=1.0, help="inertia sc
                                                                      "by itself when the pile accelerates (eq. 4.8c)")
 parser.add_argument("--ramp-time", type=float, help="duration of the head rise [s] (default the scene's 0.3 s)")
 parser.add_argument("--hold-time", type=float, help="head held at the crest after the rise [s] (default the scene's 0.35 s)")
+parser.add_argument("--submerged", action="store_true",
+                    help="the pile under still water (yade_mpm.sandpile.SUBMERGED: excess pore pressure, theory.md eq. 1.9; "
+                         "semi-implicit, the head rising over a laboratory minute)")
 parser.add_argument("--head-start", type=float, help="inflow water level at the start, also the pile's starting water table [m] (default the scene's 0.03 m)")
 args = parser.parse_args(sys.argv[1:])
 
-SCENE = sandpile.DEFAULT
+SCENE = sandpile.SUBMERGED if args.submerged else sandpile.DEFAULT
+SUBMERGED = SCENE.still_water_level is not None
+if SUBMERGED and args.scheme != "semi-implicit":
+    raise ValueError("--submerged runs on --scheme semi-implicit (got %r)" % args.scheme)
 if args.ramp_time is not None or args.hold_time is not None or args.head_start is not None:
     SCENE = dataclasses.replace(SCENE, head_ramp_time=SCENE.head_ramp_time if args.ramp_time is None else args.ramp_time,
                                 hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time,
@@ -99,11 +105,13 @@ water = MpmWaterMat(label="water", density=SCENE.water_density, bulkModulus=SCEN
 O.materials.append([soil, water])
 positions, spacing = sandpile.pile_points(SCENE, CELL, points_per_cell=2)
 solid_body, water_body = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=GRAVITY,
-                                                   surface=SCENE.surface_height(positions[:, 0]), water_table=SCENE.head_start,
+                                                   surface=SCENE.surface_height(positions[:, 0]),
                                                    lateral_earth_pressure=1 - math.sin(SCENE.friction_angle),
                                                    # the explicit scheme's surface holds the suction; the semi-implicit one has
                                                    # no capillary face yet, so there the sand above the table is dry
-                                                   suction_above_table=not SEMI_IMPLICIT, dry_above_table=SEMI_IMPLICIT)
+                                                   **(dict(still_water_level=SCENE.still_water_level) if SUBMERGED else
+                                                      dict(water_table=SCENE.head_start, suction_above_table=not SEMI_IMPLICIT,
+                                                           dry_above_table=SEMI_IMPLICIT)))
 O.bodies.append([solid_body, water_body])
 solid, fluid = solid_body.shape, water_body.shape
 start_positions = solid.pos.copy()
@@ -116,6 +124,7 @@ engine = MpmTwoPhaseEngine(
     # by default the pile still runs on the explicit scheme with its relaxations (theory.md eqs.
     # 4.17b-c, 2.3b); porting it to the semi-implicit scheme is the sand-pile issue's work
     scheme=args.scheme, pressureModeDamping=not SEMI_IMPLICIT, inertiaScale=args.inertia_scale,
+    stillWaterLevel=SCENE.still_water_level if SUBMERGED else float("-inf"),  # pore pressures are excess ones when submerged
     #            xMin (inflow)  xMax      yMin (front)   yMax (rear)    zMin (base)    zMax
     solidWalls=("slip",        "free",   "slip",        "slip",        "frictional",  "free"),
     wallFriction=(0,           0,        0,             0,             math.tan(SCENE.base_friction_angle), 0),
@@ -333,8 +342,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 xs = np.linspace(0, SCENE.flume_length, 200)
 outline = SCENE.surface_height(xs)
-pmax = SCENE.water_density * G * SCENE.head_end  # hydrostatic at the base under the final head [Pa]
-pmin = -SCENE.water_density * G * (SCENE.pile_height - SCENE.head_start)  # suction at the crest at the start [Pa]
+if SUBMERGED:  # excess pressures: at most the final excess head, no suction
+    pmax = SCENE.water_density * G * (SCENE.head_end - SCENE.still_water_level)
+    pmin = -0.1 * pmax
+else:
+    pmax = SCENE.water_density * G * SCENE.head_end  # hydrostatic at the base under the final head [Pa]
+    pmin = -SCENE.water_density * G * (SCENE.pile_height - SCENE.head_start)  # suction at the crest at the start [Pa]
 
 
 def frame(ax, title):

@@ -186,7 +186,8 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 						throw InvalidParameter(std::string("face ") + faceName(f) + ": solidWalls 'free' with waterWalls 'impermeable' (an undrained face over a free skeleton, which " +
 						                       set.name + " reaches) is not supported by scheme = 'semi-implicit' yet (its projection is unstable there, theory.md §8 Open): use scheme = 'explicit', a 'drained' or 'free' water wall, or a skeleton wall ('slip', 'fixed', 'plate')");
 		}
-	// eq. 1.9 holds below the still water only: soil above it would weigh as if submerged
+	// eq. 1.9 holds below the still water only: soil above it would weigh as if submerged (water
+	// points above it are seepage that has left the soil into the still water: they are let be)
 	const Real g = settings_.gravity.norm();
 	if (domain_.boundaries.submerged() && g > 0) {
 		auto requireBelowLevel = [&](const MaterialPointSet& P, const std::string& name) {
@@ -195,13 +196,12 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 				if (elevation > domain_.boundaries.stillWaterLevel) {
 					std::ostringstream what;
 					what << "stillWaterLevel = " << domain_.boundaries.stillWaterLevel << " m lies below " << name << ".position[" << p << "] (elevation " << elevation
-					     << " m): the excess-pressure formulation (theory.md eq. 1.9) needs every point under the still water; raise the level above the soil's top or leave it at -inf";
+					     << " m): the excess-pressure formulation (theory.md eq. 1.9) needs the soil under the still water; raise the level above the soil's top or leave it at -inf";
 					throw InvalidParameter(what.str());
 				}
 			}
 		};
 		for (const SolidSet& set : solids) requireBelowLevel(*set.points, set.name);
-		for (std::size_t w = 0; w < waters.size(); ++w) requireBelowLevel(*waters[w], w < waterNames.size() ? waterNames[w] : "water set " + std::to_string(w));
 		if (waters.empty()) throw InvalidParameter("stillWaterLevel is finite but the scene has no water points: the excess-pressure formulation (theory.md eq. 1.9) is for saturated soil");
 	}
 	solids_ = std::move(solids);
@@ -726,6 +726,24 @@ void TwoPhaseSolver::injectInflowingWater()
 					inflowNearest_[row] = static_cast<long>(p);
 				}
 			}
+			// rows whose patch of the face the skeleton reaches: the reservoir wets the soil only; above
+			// the soil the face supplies no free water into the empty domain (a screen above a submerged
+			// pile's crest, theory.md eq. 2.5)
+			inflowSoil_.assign(rows1 * rows2, 0);
+			for (const SolidSet& set : solids_) {
+				const SolidPointSet& S = *set.points;
+				for (std::size_t p = 0; p < S.size(); ++p) {
+					const Vec3& x = S.position[p];
+					const Vec3& l = S.halfLength[p];
+					if (!(inward * (x[axis] - plane) - l[axis] < s)) continue;
+					const long lo1 = static_cast<long>(std::floor((x[a1] - l[a1] - lower[a1]) / spacing[a1]));
+					const long hi1 = static_cast<long>(std::ceil((x[a1] + l[a1] - lower[a1]) / spacing[a1]));
+					const long lo2 = static_cast<long>(std::floor((x[a2] - l[a2] - lower[a2]) / spacing[a2]));
+					const long hi2 = static_cast<long>(std::ceil((x[a2] + l[a2] - lower[a2]) / spacing[a2]));
+					for (long r1 = std::max<long>(0, lo1); r1 < std::min<long>(rows1, hi1); ++r1)
+						for (long r2 = std::max<long>(0, lo2); r2 < std::min<long>(rows2, hi2); ++r2) inflowSoil_[r1 * rows2 + r2] = 1;
+				}
+			}
 			removeFlags_.assign(w->size(), 0);
 			bool anyRemoved = false;
 			// a row below the water table that no water point reaches any more (the water under a
@@ -736,7 +754,7 @@ void TwoPhaseSolver::injectInflowingWater()
 			// face) still wet it, and a point added there packed the face's cell with water (Charny's
 			// dam with FLIP: 1.8 times its volume by 2.7 s)
 			for (std::size_t row = 0; row < inflowNearest_.size(); ++row) {
-				if (inflowNearest_[row] >= 0 || inflowBuffer_[row] >= 0 || inflowCoverage_[row] > uncoveredRow) continue;
+				if (inflowNearest_[row] >= 0 || inflowBuffer_[row] >= 0 || inflowCoverage_[row] > uncoveredRow || !inflowSoil_[row]) continue;
 				const long r1 = static_cast<long>(row) / rows2, r2 = static_cast<long>(row) % rows2;
 				long       neighbour = -1;
 				for (const std::array<long, 2>& d : { std::array<long, 2> { 0, 1 }, { 0, -1 }, { 1, 0 }, { -1, 0 } }) {

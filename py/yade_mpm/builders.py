@@ -56,7 +56,7 @@ def saturated_block(lower, upper, cell_size, soil, water, points_per_cell=2, gra
 
 
 def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), surface=None, water_table=None,
-                     lateral_earth_pressure=None, suction_above_table=False, dry_above_table=False):
+                     lateral_earth_pressure=None, suction_above_table=False, dry_above_table=False, still_water_level=None):
     """Solid and water points at the same `positions` (N×3 [m]), each the centre of a cube of side
     `spacing` [m] (V0 = spacing³, GIMP half-length spacing/2), with porosity soil.porosity.
 
@@ -73,6 +73,10 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
     start stress-free at p = 0. With `dry_above_table` (level gravity only) there are water points
     only below the table: the sand above it is dry, and the skeleton carries its dry weight
     (1 − n) ρs |b_z| above the table and the saturated weight below it, less p.
+    With `still_water_level` [m] (level gravity; pass no `water_table`) the soil lies under still
+    water (the engine's stillWaterLevel, theory.md eq. 1.9): the pore pressures are the excess over
+    its hydrostatic pressure, 0 at rest, and the skeleton carries its buoyant weight,
+    σ′_zz = −(1 − n)(ρs − ρw) |b_z| (surface − z); every point must lie below the level.
 
     Returns (solid_body, water_body), two non-dynamic Bodies to append to O.bodies.
     """
@@ -95,6 +99,14 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
     pore_pressure = np.zeros(count)
     stress = np.zeros((count, 3, 3))
     if g > 0:
+        if still_water_level is not None:
+            if water_table is not None or suction_above_table or dry_above_table or gravity[:2].any():
+                raise ValueError("still_water_level = %r m excludes water_table, suction_above_table and dry_above_table and needs level gravity"
+                                 % (still_water_level,))
+            if not (np.isfinite(still_water_level) and z.max() <= still_water_level):
+                raise ValueError("still_water_level = %r m is outside the valid range [%g, inf): the highest point's elevation"
+                                 % (still_water_level, z.max()))
+            water_table = still_water_level  # only to pass the check below; the pressures are excess ones
         if surface is None or water_table is None:
             raise ValueError("a geostatic start needs the ground surface and the water table elevations [m]")
         surface = np.broadcast_to(np.asarray(surface, dtype=float), (count,))
@@ -105,7 +117,10 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
         pore_pressure = rho_w * g * (float(water_table) - z)
         if not suction_above_table:
             pore_pressure = np.clip(pore_pressure, 0, None)
-        if dry_above_table:
+        if still_water_level is not None:
+            pore_pressure = np.zeros(count)  # excess over the still water's hydrostatic pressure
+            vertical = -(1 - n0) * (soil.density - rho_w) * g * (surface - z)  # the buoyant weight
+        elif dry_above_table:
             if suction_above_table or gravity[:2].any():
                 raise ValueError("dry_above_table needs level gravity and no suction_above_table")
             rho_dry = (1 - n0) * soil.density

@@ -56,6 +56,10 @@ class SandPileScene:
     settle_time: float = 0.05        # head held at head_start from t = 0 [s]
     head_ramp_time: float = 0.3      # duration of the linear rise that follows [s]
     hold_time: float = 0.35          # head held at head_end after the rise [s]
+    # Elevation of still water over the whole flume [m], or None (the pile stands in air). With it the
+    # pile is submerged: the downstream flume holds still water at this level, the inflow head rises
+    # from it, and the model solves the excess pore pressure (engine stillWaterLevel, theory.md eq. 1.9).
+    still_water_level: float = None
 
     def toe_x(self):
         """x of the downstream toe [m]."""
@@ -85,8 +89,12 @@ class SandPileScene:
             raise ValueError("slope_angle = %r rad is outside the valid range (0, π/2)" % self.slope_angle)
         if self.toe_x() >= self.flume_length:
             raise ValueError("the pile's toe x = %.3f m lies beyond the flume length %.3f m" % (self.toe_x(), self.flume_length))
-        if not (0 <= self.head_start <= self.head_end <= self.pile_height):
-            raise ValueError("heads must satisfy 0 ≤ head_start ≤ head_end ≤ pile_height; got %r, %r, %r m" % (self.head_start, self.head_end, self.pile_height))
+        if self.still_water_level is None:
+            if not (0 <= self.head_start <= self.head_end <= self.pile_height):
+                raise ValueError("heads must satisfy 0 ≤ head_start ≤ head_end ≤ pile_height; got %r, %r, %r m" % (self.head_start, self.head_end, self.pile_height))
+        elif not (self.pile_height <= self.still_water_level <= self.head_start <= self.head_end):
+            raise ValueError("a submerged pile needs pile_height ≤ still_water_level ≤ head_start ≤ head_end; got %r, %r, %r, %r m"
+                             % (self.pile_height, self.still_water_level, self.head_start, self.head_end))
         if not (0 <= self.base_friction_angle < math.pi / 2):
             raise ValueError("base_friction_angle = %r rad is outside the valid range [0, π/2)" % self.base_friction_angle)
         if self.pile_height >= self.flume_height:
@@ -94,6 +102,15 @@ class SandPileScene:
 
 
 DEFAULT = SandPileScene()
+
+# The same pile submerged 1 cm under still water (the downstream flume full, as behind a weir),
+# the inflow reservoir raised from that level by up to one pile height over a laboratory minute
+# (2 mm/s), after 1 s at the still level in which the pile settles. Fully saturated from the start,
+# so no partially saturated zone forms (the paper's aim in raising the inflow head); no seepage at
+# the start, so the 30° slope of a 36° sand stands; the rising head drives seepage out of the slope
+# and the toe, whose upward force is what fails it.
+SUBMERGED = SandPileScene(still_water_level=0.13, head_start=0.13, head_end=0.25, settle_time=1.0, head_ramp_time=60.0, hold_time=20.0,
+                          water_bulk_modulus=2.2e9)
 
 
 def pile_points(scene, cell_size, points_per_cell=2):
@@ -121,7 +138,13 @@ def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing):
     Returns the slope_stability.CriticalCircle (its .factor is the factor of safety)."""
     from . import slope_stability
     strength = slope_stability.Strength(cohesion=0.0, friction_angle=scene.friction_angle, dilatancy_angle=scene.dilatancy_angle).davis()
-    section = slope_stability.section_from_points(solid.pos, solid.mass, fluid.pos, fluid.mass, fluid.porePressure, gravity,
+    solid_mass, water_mass = np.asarray(solid.mass), np.asarray(fluid.mass)
+    if scene.still_water_level is not None:
+        # submerged (eq. 1.9): buoyant grains, weightless water and excess pore pressures — Bishop's
+        # method with effective unit weights, equivalent to the total weights with the still water's
+        # pressure on the ground surface
+        solid_mass, water_mass = solid_mass * (1 - scene.water_density / scene.grain_density), np.zeros(len(water_mass))
+    section = slope_stability.section_from_points(solid.pos, solid_mass, fluid.pos, water_mass, fluid.porePressure, gravity,
                                                   scene.flume_width, cell_size, strength, direction=1, base_z=0.0,
                                                   surface_offset=0.5 * point_spacing)
     height, toe = scene.pile_height, scene.toe_x()

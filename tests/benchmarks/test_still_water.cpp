@@ -126,7 +126,8 @@ TEST(StillWater, UpwardSeepageIntoStillWaterCarriesDarcysFlux)
 	EXPECT_LT(sigmaError, 0.02 * c.buoyantUnitWeight() * H);
 }
 
-// Input checks (before any work): a level that is not a finite elevation, and soil above the level.
+// Input checks (before any work): a level that is not a finite elevation, and soil (solid points)
+// above the level.
 TEST(StillWater, RefusesALevelBelowTheSoilAndANonFiniteOne)
 {
 	SoilParameters  soil;

@@ -364,7 +364,7 @@ def dry_over_wet_column(height=0.5, cell=0.05, table=0.3, corrections=0, scheme=
     solid_body, water_body = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=G, surface=height, water_table=table,
                                                        dry_above_table=True)
     O.bodies.append([solid_body, water_body])
-    O.engines = [w.MpmTwoPhaseEngine(gravity=G, domainMin=(0, 0, 0), domainMax=(cell, cell, height + 2 * cell), cellSize=cell,
+    O.engines = [w.MpmTwoPhaseEngine(gravity=G, domainMin=(0, 0, 0), domainMax=(cell, cell, cell * np.ceil(height / cell + 2)), cellSize=cell,
                                      solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("free",),
                                      freeSurfaceThreshold=0.75, pressureCorrections=corrections, scheme=scheme)]
     return positions, solid_body.shape, water_body.shape
@@ -415,3 +415,52 @@ def test_saturated_surface_between_node_planes_stays_at_rest():
     assert np.linalg.norm(fluid.vel, axis=1).max() < 1e-5
     base = np.argmin(fluid.pos[:, 2])
     assert abs(fluid.porePressure[base] - 1000 * 9.81 * (0.275 - fluid.pos[base, 2])) < 0.01 * 1000 * 9.81 * 0.275
+
+
+def submerged_column(height=0.275, cell=0.05, level=0.4):
+    """The column of the test above (surface half a cell below a node plane) under still water at
+    `level` (engine stillWaterLevel, theory.md eq. 1.9), built with saturated_points(still_water_level=)."""
+    soil = w.MpmSoilMat(density=2650, youngModulus=20e6, poissonRatio=0.3, porosity=0.4, intrinsicPermeability=1e-10)
+    water = w.MpmWaterMat(density=1000, bulkModulus=2.2e9, viscosity=1e-3)
+    O.materials.append([soil, water])
+    spacing = cell / 2
+    z = spacing * (np.arange(int(round(height / spacing))) + 0.5)
+    X, Y, Z = np.meshgrid(spacing * (np.arange(2) + 0.5), spacing * (np.arange(2) + 0.5), z, indexing="ij")
+    positions = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+    solid_body, water_body = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=G, surface=height, still_water_level=level)
+    O.bodies.append([solid_body, water_body])
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm", gravity=G, domainMin=(0, 0, 0), domainMax=(cell, cell, cell * np.ceil(height / cell + 2)), cellSize=cell,
+                                     solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("free",),
+                                     freeSurfaceThreshold=0.75, stillWaterLevel=level)]
+    return solid_body.shape, water_body.shape
+
+
+def test_submerged_surface_between_node_planes_stays_at_rest_and_the_level_is_saved(tmp_path):
+    """The saturated column of the xfail above, submerged under still water (excess pore pressure,
+    theory.md eq. 1.9): it starts with p = 0 and the buoyant geostatic stress σ′zz = −(1 − n)(ρs − ρw)
+    g (H − z) (saturated_points), and stays there over 0.3 s: excess pressure below 1e-9 γw H and
+    speeds below 1e-9 m/s — the still water's weight and its hydrostatic pressure cancel exactly,
+    wherever the surface lies in its cell. The level survives O.save/O.load."""
+    height = 0.275
+    solid, fluid = submerged_column(height=height)
+    assert np.allclose(solid.stress[:, 2, 2], -0.6 * (2650 - 1000) * 9.81 * (height - solid.pos[:, 2]), rtol=1e-12)
+    O.dt = 1e-3
+    O.run(300, True)
+    assert np.abs(fluid.porePressure).max() < 1e-9 * 1000 * 9.81 * height
+    assert max(np.linalg.norm(fluid.vel, axis=1).max(), np.linalg.norm(solid.vel, axis=1).max()) < 1e-9
+    path = str(tmp_path / "submerged.xml.bz2")
+    O.save(path)
+    O.load(path)
+    assert O.engines[0].stillWaterLevel == 0.4
+
+
+def test_soil_above_the_still_water_is_refused_naming_the_attribute():
+    """A still water level below the soil's top is refused before any work, naming stillWaterLevel."""
+    solid, _ = submerged_column(height=0.275, level=0.4)
+    O.engines[0].stillWaterLevel = 0.2
+    start = solid.pos.copy()
+    with pytest.raises(RuntimeError, match=r"stillWaterLevel = 0\.2 m lies below O\.bodies\[0\]\.shape\.position"):
+        O.run(1, True)
+    assert np.array_equal(solid.pos, start)
+    with pytest.raises(ValueError, match="still_water_level"):
+        submerged_column(height=0.275, level=0.2)
