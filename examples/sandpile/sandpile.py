@@ -56,6 +56,9 @@ parser.add_argument("--scheme", choices=("explicit", "semi-implicit"), default="
                          "semi-implicit (no relaxation; no capillary face yet, so the sand above the water table starts dry)")
 parser.add_argument("--inertia-scale", type=float, default=1.0, help="inertia scaling α ≥ 1 of both phases (theory.md eq. 4.8b), released "
                                                                      "by itself when the pile accelerates (eq. 4.8c)")
+parser.add_argument("--inertia-release", type=float, default=0.1,
+                    help="release threshold ε of the inertia scaling (engine inertiaScaleRelease, theory.md eq. 4.8c): the skeleton's "
+                         "net inertial force over its weight; a slide of a fraction f of the pile shows as about f × its imbalance")
 parser.add_argument("--ramp-time", type=float, help="duration of the head rise [s] (default the scene's 0.3 s)")
 parser.add_argument("--hold-time", type=float, help="head held at the crest after the rise [s] (default the scene's 0.35 s)")
 parser.add_argument("--submerged", action="store_true",
@@ -124,6 +127,7 @@ engine = MpmTwoPhaseEngine(
     # by default the pile still runs on the explicit scheme with its relaxations (theory.md eqs.
     # 4.17b-c, 2.3b); porting it to the semi-implicit scheme is the sand-pile issue's work
     scheme=args.scheme, pressureModeDamping=not SEMI_IMPLICIT, inertiaScale=args.inertia_scale,
+    inertiaScaleRelease=args.inertia_release,
     stillWaterLevel=SCENE.still_water_level if SUBMERGED else float("-inf"),  # pore pressures are excess ones when submerged
     #            xMin (inflow)  xMax      yMin (front)   yMax (rear)    zMin (base)    zMax
     solidWalls=("slip",        "free",   "slip",        "slip",        "frictional",  "free"),
@@ -302,6 +306,7 @@ summary = {
     "stopped_unstable": stopped,
     "scheme": args.scheme,
     "inertia_scale": args.inertia_scale,
+    "inertia_scale_release": args.inertia_release,
     "inertia_scale_release_time_s": engine.inertiaScaleReleaseTime if engine.inertiaScaleReleaseTime >= 0 else None,
     "explicit_steps": int(engine.solverSteps),
     "critical_time_step_s": engine.criticalTimeStep,

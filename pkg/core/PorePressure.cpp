@@ -35,6 +35,25 @@ namespace stages {
 		return filling;
 	}
 
+	Real skeletonFilling(const GridGeometry& grid, const GridFields& fields, const Vec3& position)
+	{
+		Weights1D w[3];
+		weightsAt<LinearKernel>(grid, position, Vec3::Zero(), w);
+		int node[3][LinearKernel::stencil];
+		stencilNodes(grid, w, node);
+		Real filling = 0;
+		for (int c = 0; c < LinearKernel::stencil; ++c)
+			for (int b = 0; b < LinearKernel::stencil; ++b)
+				for (int a = 0; a < LinearKernel::stencil; ++a) {
+					const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
+					if (N <= 0) continue;
+					const int  i = node[0][a], j = node[1][b], k = node[2][c];
+					const Real full = grid.inDomainSupportVolume(i, j, k);
+					filling += N * (full > 0 ? std::min<Real>(1, fields.solid[grid.index(i, j, k)].volume / full) : 0.0);
+				}
+		return filling;
+	}
+
 	// Linear least-squares fit of the pressures of the points in the 3×3×3 cells around `cell`
 	// (eq. 4.17c), free-surface points left out.
 	static PressureFit fitAroundCell(const GridGeometry& grid, const std::vector<PressureCell>& cells, const std::array<int, 3>& cell)

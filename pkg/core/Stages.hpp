@@ -226,6 +226,10 @@ namespace stages {
 
 	// Advance the pore pressure with the (possibly cell-averaged) rate (explicit scheme).
 	void updatePorePressure(const std::vector<Real>& pressureRate, WaterPointSet& points, Real dt);
+	// The share of the space around `position` that the skeleton occupies: Σ S_I(x) min(1, V_I/V^full_I)
+	// with the hat (point-sized) weights, V_I the solid points' mixture volume mapped to node I and
+	// V^full_I the node's in-domain support volume. 1 inside the soil, ½ on its surface, 0 outside.
+	Real skeletonFilling(const GridGeometry& grid, const GridFields& fields, const Vec3& position);
 	// Advance the water points' volume with the (possibly cell-averaged) divergence: V ← V (1 + Δt ∇·v^w).
 	void updateWaterVolume(const std::vector<Real>& waterDivergence, WaterPointSet& points, Real dt);
 

@@ -34,6 +34,9 @@ namespace {
 	// (round-off, e.g. a column at rest), and one with less than it left inside leaves whole
 	// (theory.md eq. 2.4).
 	constexpr double outflowRemnant = 1e-9;
+	// skeleton filling at a water point's centre below which it has crossed a submerged soil surface
+	// (½: the centre on the skeleton's edge, as a centre crossing a drained face, eq. 2.4)
+	constexpr double submergedOutflowFilling = 0.5;
 	// Rate of the edge smoothing (eq. 4.17c) as a share of the interior one, c_v/h². Relaxing towards
 	// a 3-cell linear fit also flattens a smooth curved field: it adds about share/3 × c_v to the
 	// consolidation diffusivity, so 0.03 keeps that below 1% while still damping the cell modes of
@@ -613,7 +616,7 @@ void TwoPhaseSolver::removeOutflowingWater()
 {
 	bool drainedFace = false;
 	for (int f = 0; f < faceCount; ++f) drainedFace = drainedFace || domain_.boundaries.walls[f].water == WaterWall::Drained;
-	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid && !domain_.removeFreeWater && !drainedFace) return;
+	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid && !domain_.removeFreeWater && !drainedFace && !domain_.boundaries.submerged()) return;
 	const Vec3 faceLower = grid_.lower(), faceUpper = grid_.upper();
 	for (WaterPointSet* w : waters_) {
 		const std::size_t n = w->size();
@@ -624,6 +627,9 @@ void TwoPhaseSolver::removeOutflowingWater()
 			for (const WaterSink& sink : domain_.sinks) out = out || sink.contains(w->position[p]);
 			// n = 1 exactly when no node of the point's stencil carries solid (eq. 4.5, this step)
 			out = out || (domain_.removeFreeWater && w->porosity[p] >= 1);
+			// under still water (eq. 1.9) water whose centre has left the skeleton has joined the
+			// still water, which the model does not carry (weightless, it would pile up on the surface)
+			out = out || (domain_.boundaries.submerged() && stages::skeletonFilling(grid_, fields_, w->position[p]) < submergedOutflowFilling);
 			// the part of a point beyond a drained face has left through it (eq. 2.4)
 			for (int f = 0; f < faceCount && !out; ++f) {
 				if (domain_.boundaries.walls[f].water != WaterWall::Drained || grid_.periodic[f / 2]) continue;

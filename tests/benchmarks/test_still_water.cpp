@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
@@ -32,11 +33,11 @@ struct SubmergedColumn {
 	// fixed impermeable base); the soil's top is its own free surface, two cells below the domain's top
 	double          height;
 
-	explicit SubmergedColumn(double excessHead, double soilHeight = H)
+	explicit SubmergedColumn(double excessHead, double soilHeight = H, bool inflow = false, double conductivity = k)
 	        : height(soilHeight)
 	{
 		soil.porosity              = 0.4;
-		soil.intrinsicPermeability = k * water.viscosity / (water.density * g);
+		soil.intrinsicPermeability = conductivity * water.viscosity / (water.density * g);
 		const auto l               = fixtures::lattice(Vec3::Zero(), Vec3(h, h, height), h, 2);
 		solid                      = fixtures::solidLattice(l, soil.porosity, soil.density);
 		fluid                      = fixtures::waterLattice(l, soil.porosity, water.density);
@@ -49,7 +50,7 @@ struct SubmergedColumn {
 		Domain d = fixtures::columnDomain(Vec3(h, h, H + 2 * h), h);
 		if (height > H) throw std::invalid_argument("the column's height must be at most H");
 		d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Free };
-		if (excessHead > 0) fixtures::reservoirFace(d, Face::ZMin, height + waterAboveSoil + excessHead, false, SolidWall::Fixed);
+		if (excessHead > 0) fixtures::reservoirFace(d, Face::ZMin, height + waterAboveSoil + excessHead, inflow, SolidWall::Fixed);
 		d.boundaries.stillWaterLevel = height + waterAboveSoil;
 		d.removeFreeWater            = true; // seepage that leaves the soil's top joins the still water
 		SolverSettings s;
@@ -124,6 +125,57 @@ TEST(StillWater, UpwardSeepageIntoStillWaterCarriesDarcysFlux)
 	EXPECT_LT(pError, 0.02 * i * gammaW * H);
 	EXPECT_LT(std::abs(fluxError), 0.02);
 	EXPECT_LT(sigmaError, 0.02 * c.buoyantUnitWeight() * H);
+}
+
+// The same seepage carried by points (point layers leave every 1.27 s): water
+// enters through the base as new points (eq. 2.5) and leaves the soil's submerged top once a point's
+// centre is outside the skeleton (it has joined the still water, eq. 1.9). Points leave a layer at a
+// time, so the outflow rate is taken over four whole layers, from the first layer's first departure to the
+// fifth's; the inflow
+// (continuous: buffers) over the same span. Both equal Darcy's flux k i ρw A; the water's mass
+// balances to round-off. (At k = 0.05 m/s the water points' volumes drift, 1.5 times their mass's
+// by 1.25 s, and the column blows up at 1.3 s — theory.md §8 Open, the volume drift; in the total
+// form the same column ponds its outflow on its top and its points' volumes drift as far.)
+TEST(StillWater, SeepageEntersAtTheBaseAndLeavesThroughTheSubmergedSurfaceAsPoints)
+{
+	const double    gammaW = WaterParameters {}.density * g, conductivity = 0.01;
+	SubmergedColumn probe(0);
+	const double    i = 0.8 * probe.buoyantUnitWeight() / gammaW;
+	const double    height = H / 2;
+	SubmergedColumn c(i * height, height, true, conductivity);
+	auto            stored = [&] {
+                double m = 0;
+                for (double mp : c.fluid.mass) m += mp;
+                return m;
+	};
+	const double initial = stored();
+	const double dt      = 0.5 * c.solver->timeStepLimits().critical;
+	// the points of a layer leave within a few steps of each other; a departure more than 0.5 s
+	// (0.4 of the layer period) after the previous one starts the next layer
+	double                             t = 0, lastOut = 0, lastDeparture = -1;
+	std::vector<std::array<double, 3>> layers; // (time, removed, injected) just before each layer's first departure
+	double                             injectedBefore = 0;
+	while (layers.size() < 5 && t < 8.0) {
+		injectedBefore = c.solver->injectedWaterMass();
+		c.solver->step(dt);
+		t += dt;
+		if (c.solver->removedWaterMass() > lastOut) {
+			if (t - lastDeparture > 0.5) layers.push_back({ t, lastOut, injectedBefore });
+			lastDeparture = t;
+		}
+		lastOut = c.solver->removedWaterMass();
+	}
+	ASSERT_EQ(layers.size(), 5u) << "fewer than five layers left in 8 s";
+	const double span = layers[4][0] - layers[0][0], darcy = conductivity * i * c.water.density * h * h; // [kg s⁻¹]
+	const double outRate = (layers[4][1] - layers[0][1]) / span, inRate = (layers[4][2] - layers[0][2]) / span;
+	const double balance = (stored() + c.solver->removedWaterMass() - initial - c.solver->injectedWaterMass()) / initial;
+	std::printf("seepage through the submerged surface (layers began to leave at %.3f … %.3f s): in %+.4f, out %+.4f of Darcy's %.4e kg/s; balance %.1e\n",
+	            layers[0][0], layers[4][0], inRate / darcy - 1, outRate / darcy - 1, darcy, balance);
+	EXPECT_NEAR(inRate / darcy, 1, 0.02);
+	// measured +3.5% (+4.0% with H = 1 m): the points' volumes drift from their masses (V/V0 up to
+	// 1.1 by 4 s), theory.md §8 Open; the bound states that, it is not Charny's 2%
+	EXPECT_NEAR(outRate / darcy, 1, 0.05);
+	EXPECT_LT(std::abs(balance), 1e-12);
 }
 
 // Input checks (before any work): a level that is not a finite elevation, and soil (solid points)
