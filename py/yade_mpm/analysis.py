@@ -31,6 +31,35 @@ def kinetic_onset(times, energies, sustain=5, growth=10.0):
     return None
 
 
+def compliance_onset(loads, displacements, reference_records=3, ratio=10.0, sustain=3):
+    """Onset of failure under a slowly rising load (a head ramp): the first record from which the
+    displacement grows faster with the load than `ratio` (> 1) times the elastic compliance, the
+    increment du/dload between records measured over the first `reference_records` (≥ 1)
+    increments of the rise, and stays so for `sustain` (≥ 1) increments — the softening of the
+    load–displacement curve a slope shows as it yields, as a dimensionless ratio, with no
+    displacement threshold. Only records where the load rises count (a hold at the end is not a
+    rise). Returns the index of that record, or None."""
+    if not (int(reference_records) >= 1 and int(sustain) >= 1):
+        raise ValueError("reference_records = %r and sustain = %r must lie in [1, inf)" % (reference_records, sustain))
+    if not ratio > 1:
+        raise ValueError("ratio = %r is outside the valid range (1, inf)" % (ratio,))
+    q, u = np.asarray(loads, dtype=float), np.asarray(displacements, dtype=float)
+    if q.shape != u.shape:
+        raise ValueError("loads and displacements must have the same length")
+    rising = np.flatnonzero(np.diff(q) > 0)  # increment i: from record i to i + 1
+    if len(rising) < int(reference_records) + int(sustain):
+        return None
+    compliance = (u[rising + 1] - u[rising]) / (q[rising + 1] - q[rising])
+    elastic = abs(float(np.median(compliance[:int(reference_records)])))
+    if not elastic > 0:
+        return None
+    soft = compliance > ratio * elastic
+    for j in range(int(reference_records), len(rising) - int(sustain) + 1):
+        if soft[j:j + int(sustain)].all():
+            return int(rising[j])
+    return None
+
+
 def toe_runout(start_positions, positions, toe_x, base_band):
     """Advance of the toe front [m]: the largest x of the solid points within `base_band` [m] of
     the base (z ≤ base_band) now, less the toe's x at the start (`toe_x`); 0 if none moved past it."""

@@ -103,13 +103,13 @@ class SandPileScene:
 
 DEFAULT = SandPileScene()
 
-# The same pile submerged 1 cm under still water (the downstream flume full, as behind a weir),
+# The same pile submerged 3 cm under still water (the downstream flume full, as behind a weir),
 # the inflow reservoir raised from that level by up to one pile height over a laboratory minute
 # (2 mm/s), after 1 s at the still level in which the pile settles. Fully saturated from the start,
 # so no partially saturated zone forms (the paper's aim in raising the inflow head); no seepage at
 # the start, so the 30° slope of a 36° sand stands; the rising head drives seepage out of the slope
 # and the toe, whose upward force is what fails it.
-SUBMERGED = SandPileScene(still_water_level=0.13, head_start=0.13, head_end=0.25, settle_time=1.0, head_ramp_time=60.0, hold_time=20.0,
+SUBMERGED = SandPileScene(still_water_level=0.15, head_start=0.15, head_end=0.27, settle_time=1.0, head_ramp_time=60.0, hold_time=20.0,
                           water_bulk_modulus=2.2e9)
 
 

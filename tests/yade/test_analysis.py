@@ -45,3 +45,21 @@ def test_runout_profile_and_mobilised_volume_of_a_shifted_wedge():
     volumes = np.full(len(start), spacing ** 3)
     volume, fraction = analysis.mobilised_volume(start, moved, volumes, displacement=spacing)
     assert volume == pytest.approx(sliding.sum() * spacing ** 3) and fraction == pytest.approx(sliding.mean())
+
+
+def test_compliance_onset_is_where_the_load_displacement_curve_softens_tenfold():
+    """Elastic u = c (H − H0) up to H_y, then a parabola whose slope grows as c + 2a(H − H_y):
+    the compliance passes 10 c where 2a(H − H_y) = 9 c. The onset is the first increment whose
+    whole compliance exceeds 10 c; a hold at the end (no rise) is ignored; a purely elastic ramp
+    has none."""
+    from yade_mpm import analysis
+    c, a, hy = 1e-4, 0.05, 0.17
+    heads = np.concatenate([np.linspace(0.15, 0.27, 121), np.full(10, 0.27)])
+    u = c * (heads - 0.15) + a * np.clip(heads - hy, 0, None) ** 2
+    i = analysis.compliance_onset(heads, u)
+    # increment i → i+1 has compliance c + a (H_i + H_{i+1} − 2 H_y): the first above 10 c
+    expected = next(k for k in range(130) if c + a * (heads[k] + heads[k + 1] - 2 * hy) > 10 * c)
+    assert i == expected and heads[i] == pytest.approx(hy + 9 * c / (2 * a), abs=0.002)
+    assert analysis.compliance_onset(heads, c * (heads - 0.15)) is None
+    with pytest.raises(ValueError, match="ratio"):
+        analysis.compliance_onset(heads, u, ratio=1.0)

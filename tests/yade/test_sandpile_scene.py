@@ -43,3 +43,29 @@ def test_invalid_scene_is_refused():
 def test_base_friction_angle_out_of_range_is_refused(angle):
     with pytest.raises(ValueError, match=r"base_friction_angle = .* is outside the valid range \[0, π/2\)"):
         sandpile.pile_points(sandpile.SandPileScene(base_friction_angle=angle), 0.01)
+
+
+def test_submerged_scene_heads_start_at_the_still_water_and_are_checked():
+    s = sandpile.SUBMERGED
+    assert s.still_water_level >= s.pile_height and s.head(0) == s.still_water_level < s.head_end
+    with pytest.raises(ValueError, match="still_water_level"):
+        sandpile.pile_points(sandpile.SandPileScene(still_water_level=0.10, head_start=0.10, head_end=0.2), 0.01)
+
+
+def test_limit_equilibrium_of_the_submerged_pile_at_rest_equals_the_dry_pile():
+    """Bishop's F of a cohesionless slope with no pore pressure does not depend on the unit weight
+    (every slice's driving and resisting terms scale with it), so the submerged pile at rest (buoyant
+    weights, excess pore pressure 0: theory.md eq. 1.9) has the dry pile's F, to round-off."""
+    from types import SimpleNamespace
+    cell = 0.02
+    points, spacing = sandpile.pile_points(sandpile.DEFAULT, cell)
+    volume = spacing ** 3
+    s = sandpile.SUBMERGED
+    solid = SimpleNamespace(pos=points, mass=np.full(len(points), (1 - s.porosity) * s.grain_density * volume))
+    no_water = SimpleNamespace(pos=np.zeros((0, 3)), mass=np.zeros(0), porePressure=np.zeros(0))
+    at_rest = SimpleNamespace(pos=points, mass=np.full(len(points), s.porosity * s.water_density * volume), porePressure=np.zeros(len(points)))
+    gravity = (0.0, 0.0, -9.81)
+    dry = sandpile.limit_equilibrium(sandpile.DEFAULT, solid, no_water, gravity, cell, spacing)
+    submerged = sandpile.limit_equilibrium(s, solid, at_rest, gravity, cell, spacing)
+    assert 1.0 < dry.factor < 1.2  # Davis' φ* = 31.9° on a 30° slope: tan φ*/tan 30° = 1.08 for a shallow slide
+    assert submerged.factor == pytest.approx(dry.factor, rel=1e-9)
