@@ -64,6 +64,7 @@ parser.add_argument("--hold-time", type=float, help="head held at the crest afte
 parser.add_argument("--submerged", action="store_true",
                     help="the pile under still water (yade_mpm.sandpile.SUBMERGED: excess pore pressure, theory.md eq. 1.9; "
                          "semi-implicit, the head rising over a laboratory minute)")
+parser.add_argument("--head-end", type=float, help="inflow water level at the end of the rise [m] (default the scene's)")
 parser.add_argument("--head-start", type=float, help="inflow water level at the start, also the pile's starting water table [m] (default the scene's 0.03 m)")
 args = parser.parse_args(sys.argv[1:])
 
@@ -71,10 +72,11 @@ SCENE = sandpile.SUBMERGED if args.submerged else sandpile.DEFAULT
 SUBMERGED = SCENE.still_water_level is not None
 if SUBMERGED and args.scheme != "semi-implicit":
     raise ValueError("--submerged runs on --scheme semi-implicit (got %r)" % args.scheme)
-if args.ramp_time is not None or args.hold_time is not None or args.head_start is not None:
+if args.ramp_time is not None or args.hold_time is not None or args.head_start is not None or args.head_end is not None:
     SCENE = dataclasses.replace(SCENE, head_ramp_time=SCENE.head_ramp_time if args.ramp_time is None else args.ramp_time,
                                 hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time,
-                                head_start=SCENE.head_start if args.head_start is None else args.head_start)
+                                head_start=SCENE.head_start if args.head_start is None else args.head_start,
+                                head_end=SCENE.head_end if args.head_end is None else args.head_end)
 SEMI_IMPLICIT = args.scheme == "semi-implicit"
 GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
 G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]

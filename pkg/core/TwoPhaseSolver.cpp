@@ -37,6 +37,8 @@ namespace {
 	// skeleton filling at a water point's centre below which it has crossed a submerged soil surface
 	// (½: the centre on the skeleton's edge, as a centre crossing a drained face, eq. 2.4)
 	constexpr double submergedOutflowFilling = 0.5;
+	// share of an inflow row's face patch the skeleton must cover for the reservoir to wet it (eq. 2.5)
+	constexpr double soilCoveredRow = 0.5;
 	// Rate of the edge smoothing (eq. 4.17c) as a share of the interior one, c_v/h². Relaxing towards
 	// a 3-cell linear fit also flattens a smooth curved field: it adds about share/3 × c_v to the
 	// consolidation diffusivity, so 0.03 keeps that below 1% while still damping the cell modes of
@@ -612,6 +614,17 @@ void TwoPhaseSolver::updateDomains()
 // crossed jolted the column each time, up to 4 mm/s of skeleton speed in a k = 0.05 m/s seepage
 // column). Every mass that leaves is accounted in removedWaterMass (theory.md §2.4). Their nodal
 // mass of this step is already spent.
+bool TwoPhaseSolver::nearInflowFace(const Vec3& x) const
+{
+	for (int f = 0; f < faceCount; ++f) {
+		if (!domain_.boundaries.walls[f].inflow) continue;
+		const int  d     = f / 2;
+		const Real plane = f % 2 ? grid_.upper()[d] : grid_.lower()[d];
+		if (std::abs(x[d] - plane) < grid_.cellSize) return true;
+	}
+	return false;
+}
+
 void TwoPhaseSolver::removeOutflowingWater()
 {
 	bool drainedFace = false;
@@ -628,8 +641,11 @@ void TwoPhaseSolver::removeOutflowingWater()
 			// n = 1 exactly when no node of the point's stencil carries solid (eq. 4.5, this step)
 			out = out || (domain_.removeFreeWater && w->porosity[p] >= 1);
 			// under still water (eq. 1.9) water whose centre has left the skeleton has joined the
-			// still water, which the model does not carry (weightless, it would pile up on the surface)
-			out = out || (domain_.boundaries.submerged() && stages::skeletonFilling(grid_, fields_, w->position[p]) < submergedOutflowFilling);
+			// still water, which the model does not carry (weightless, it would pile up on the surface);
+			// not in an inflow face's cell, whose water is the reservoir's (eq. 2.5: removed there, a
+			// buffer in a loosened crest was grown again every step)
+			out = out || (domain_.boundaries.submerged() && !nearInflowFace(w->position[p]) &&
+			              stages::skeletonFilling(grid_, fields_, w->position[p]) < submergedOutflowFilling);
 			// the part of a point beyond a drained face has left through it (eq. 2.4)
 			for (int f = 0; f < faceCount && !out; ++f) {
 				if (domain_.boundaries.walls[f].water != WaterWall::Drained || grid_.periodic[f / 2]) continue;
@@ -704,20 +720,22 @@ void TwoPhaseSolver::injectInflowingWater()
 			inflowDepth_.assign(rows1 * rows2, inf);
 			inflowBuffer_.assign(rows1 * rows2, -1);
 			inflowCoverage_.assign(rows1 * rows2, 0);
+			// adds to `cover` the share of each row's patch of the face that a point's domain (x ± l) covers
+			auto coverRows = [&](const Vec3& x, const Vec3& l, std::vector<Real>& cover) {
+				const long lo1 = static_cast<long>(std::floor((x[a1] - l[a1] - lower[a1]) / spacing[a1]));
+				const long lo2 = static_cast<long>(std::floor((x[a2] - l[a2] - lower[a2]) / spacing[a2]));
+				for (long r1 = std::max<long>(0, lo1); r1 <= std::min<long>(rows1 - 1, lo1 + 1); ++r1)
+					for (long r2 = std::max<long>(0, lo2); r2 <= std::min<long>(rows2 - 1, lo2 + 1); ++r2) {
+						const Real o1 = std::min(x[a1] + l[a1], lower[a1] + (r1 + 1) * spacing[a1]) - std::max(x[a1] - l[a1], lower[a1] + r1 * spacing[a1]);
+						const Real o2 = std::min(x[a2] + l[a2], lower[a2] + (r2 + 1) * spacing[a2]) - std::max(x[a2] - l[a2], lower[a2] + r2 * spacing[a2]);
+						if (o1 > 0 && o2 > 0) cover[r1 * rows2 + r2] += o1 * o2 / (spacing[a1] * spacing[a2]);
+					}
+			};
 			for (std::size_t p = 0; p < w->size(); ++p) {
 				const Vec3& x     = w->position[p];
 				const Vec3& l     = w->halfLength[p];
 				const Real  depth = inward * (x[axis] - plane);
-				if (depth - l[axis] < s) { // its domain reaches the face's first spacing: the share of each row's patch it covers
-					const long lo1 = static_cast<long>(std::floor((x[a1] - l[a1] - lower[a1]) / spacing[a1]));
-					const long lo2 = static_cast<long>(std::floor((x[a2] - l[a2] - lower[a2]) / spacing[a2]));
-					for (long r1 = std::max<long>(0, lo1); r1 <= std::min<long>(rows1 - 1, lo1 + 1); ++r1)
-						for (long r2 = std::max<long>(0, lo2); r2 <= std::min<long>(rows2 - 1, lo2 + 1); ++r2) {
-							const Real o1 = std::min(x[a1] + l[a1], lower[a1] + (r1 + 1) * spacing[a1]) - std::max(x[a1] - l[a1], lower[a1] + r1 * spacing[a1]);
-							const Real o2 = std::min(x[a2] + l[a2], lower[a2] + (r2 + 1) * spacing[a2]) - std::max(x[a2] - l[a2], lower[a2] + r2 * spacing[a2]);
-							if (o1 > 0 && o2 > 0) inflowCoverage_[r1 * rows2 + r2] += o1 * o2 / (spacing[a1] * spacing[a2]);
-						}
-				}
+				if (depth - l[axis] < s) coverRows(x, l, inflowCoverage_); // its domain reaches the face's first spacing
 				if (!(depth >= 0 && depth < 2.5 * s)) continue;
 				const long r1 = static_cast<long>(std::floor((x[a1] - lower[a1]) / spacing[a1]));
 				const long r2 = static_cast<long>(std::floor((x[a2] - lower[a2]) / spacing[a2]));
@@ -732,22 +750,19 @@ void TwoPhaseSolver::injectInflowingWater()
 					inflowNearest_[row] = static_cast<long>(p);
 				}
 			}
-			// rows whose patch of the face the skeleton reaches: the reservoir wets the soil only; above
-			// the soil the face supplies no free water into the empty domain (a screen above a submerged
-			// pile's crest, theory.md eq. 2.5)
+			// the share of each row's patch of the face the skeleton covers: the reservoir wets the soil
+			// only (more than half the patch); above the soil the face supplies no free water into the
+			// empty domain (a screen above a submerged pile's crest, theory.md eq. 2.5). A share, not a
+			// touch: a crest risen by a micrometre must not claim the row above it (a point wetted
+			// there lies outside the skeleton and leaves at once, eq. 1.9 — the first submerged pile
+			// pumped 71 kg in and out that way)
 			inflowSoil_.assign(rows1 * rows2, 0);
 			for (const SolidSet& set : solids_) {
 				const SolidPointSet& S = *set.points;
 				for (std::size_t p = 0; p < S.size(); ++p) {
 					const Vec3& x = S.position[p];
 					const Vec3& l = S.halfLength[p];
-					if (!(inward * (x[axis] - plane) - l[axis] < s)) continue;
-					const long lo1 = static_cast<long>(std::floor((x[a1] - l[a1] - lower[a1]) / spacing[a1]));
-					const long hi1 = static_cast<long>(std::ceil((x[a1] + l[a1] - lower[a1]) / spacing[a1]));
-					const long lo2 = static_cast<long>(std::floor((x[a2] - l[a2] - lower[a2]) / spacing[a2]));
-					const long hi2 = static_cast<long>(std::ceil((x[a2] + l[a2] - lower[a2]) / spacing[a2]));
-					for (long r1 = std::max<long>(0, lo1); r1 < std::min<long>(rows1, hi1); ++r1)
-						for (long r2 = std::max<long>(0, lo2); r2 < std::min<long>(rows2, hi2); ++r2) inflowSoil_[r1 * rows2 + r2] = 1;
+					if (inward * (x[axis] - plane) - l[axis] < s) coverRows(x, l, inflowSoil_);
 				}
 			}
 			removeFlags_.assign(w->size(), 0);
@@ -760,7 +775,7 @@ void TwoPhaseSolver::injectInflowingWater()
 			// face) still wet it, and a point added there packed the face's cell with water (Charny's
 			// dam with FLIP: 1.8 times its volume by 2.7 s)
 			for (std::size_t row = 0; row < inflowNearest_.size(); ++row) {
-				if (inflowNearest_[row] >= 0 || inflowBuffer_[row] >= 0 || inflowCoverage_[row] > uncoveredRow || !inflowSoil_[row]) continue;
+				if (inflowNearest_[row] >= 0 || inflowBuffer_[row] >= 0 || inflowCoverage_[row] > uncoveredRow || !(inflowSoil_[row] > soilCoveredRow)) continue;
 				const long r1 = static_cast<long>(row) / rows2, r2 = static_cast<long>(row) % rows2;
 				long       neighbour = -1;
 				for (const std::array<long, 2>& d : { std::array<long, 2> { 0, 1 }, { 0, -1 }, { 1, 0 }, { -1, 0 } }) {
@@ -778,6 +793,8 @@ void TwoPhaseSolver::injectInflowingWater()
 				x[a2]   = lower[a2] + (r2 + 0.5) * spacing[a2];
 				x[axis] = plane + inward * 0.5 * s; // a regular point on the face's first spacing
 				if (!wall.belowWaterTable(x, settings_.gravity) || x[a1] > upper[a1] || x[a2] > upper[a2]) continue;
+				// under still water, only where the skeleton holds it (else it would leave at once, eq. 1.9)
+				if (domain_.boundaries.submerged() && stages::skeletonFilling(grid_, fields_, x) < submergedOutflowFilling) continue;
 				const std::size_t q = w->appendCopyOf(static_cast<std::size_t>(neighbour));
 				w->position[q]      = x; // with its neighbour's velocity, as a buffer takes its row's
 				w->porePressure[q]  = wall.drainedPressureAt(x, settings_.gravity, water_.density, domain_.boundaries.stillWaterLevel);

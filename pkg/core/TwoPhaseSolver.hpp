@@ -181,7 +181,7 @@ private:
 	std::vector<long>             inflowNearest_;
 	std::vector<Real>             inflowDepth_;
 	std::vector<long>             inflowBuffer_; // per inflow row: its buffer point (eq. 2.5), −1 where none
-	std::vector<char>             inflowSoil_;     // per inflow row: whether the skeleton reaches its face patch [-]
+	std::vector<Real>             inflowSoil_;     // per inflow row: the share of its face patch the skeleton's points cover [-]
 	std::vector<Real>             inflowCoverage_; // per inflow row: the share of its face patch the water points cover [-]
 	std::vector<std::vector<char>> inflowCell_; // per water set and point: within a cell of an inflow face, moved by PIC (eq. 4.11d)
 	std::vector<Vec3>             regularHalfLength_; // per water set: the half-length its inflow rows tile (eq. 2.5) [m]
@@ -192,6 +192,7 @@ private:
 	std::vector<std::vector<Vec3>> lossBuffers_;
 	TimeStepLimits                lastLimits_ {};
 	void                          removeOutflowingWater();
+	bool                          nearInflowFace(const Vec3& x) const; // within a cell of a face with waterInflow
 	std::vector<char>             removeFlags_;
 	std::vector<char>             suctionHolding_; // nodes of the suction-holding free surface (eq. 2.3b)
 	PressureModeScratch           pressureModes_; // scratch of eqs. 4.17b–c
