@@ -136,6 +136,10 @@ void MpmTwoPhaseEngine::action()
 		    << " s) or raise maxSubSteps (nothing was advanced)";
 		throw mpm::InvalidParameter(msg.str());
 	} catch (const mpm::InstabilityError& e) {
+		// the sub-steps before the unstable one moved water in and out: the counters follow the
+		// points, so that the water balance of what is left stays closed
+		removedWaterMass  = removedBefore_ + solver_->removedWaterMass();
+		injectedWaterMass = injectedBefore_ + solver_->injectedWaterMass();
 		std::ostringstream msg;
 		msg << "O.iter = " << yade::abi::iter(scene) << " (O.time = " << yade::abi::time(scene) << " s): " << e.what();
 		throw mpm::InstabilityError(msg.str());
