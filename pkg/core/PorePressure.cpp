@@ -15,43 +15,38 @@ namespace mpm {
 namespace stages {
 	using namespace detail;
 
-	// A water point's filling (eq. 2.3): Σ S_I (water volume of I / full support volume of I).
-	static Real waterFilling(const GridGeometry& grid, const GridFields& fields, const Vec3& position, const Vec3& halfLength)
+	// Σ S_I share(I) over the stencil of a point at `position` (node support volumes in the domain:
+	// the filling of eq. 2.3 and the skeleton's of eq. 1.9)
+	template <class Kernel, class Share>
+	static Real fillingAt(const GridGeometry& grid, const Vec3& position, const Vec3& halfLength, Share share)
 	{
 		Weights1D w[3];
-		weightsAt<GimpKernel>(grid, position, halfLength, w);
-		int node[3][GimpKernel::stencil];
+		weightsAt<Kernel>(grid, position, halfLength, w);
+		int node[3][Kernel::stencil];
 		stencilNodes(grid, w, node);
 		Real filling = 0;
-		for (int c = 0; c < GimpKernel::stencil; ++c)
-			for (int b = 0; b < GimpKernel::stencil; ++b)
-				for (int a = 0; a < GimpKernel::stencil; ++a) {
+		for (int c = 0; c < Kernel::stencil; ++c)
+			for (int b = 0; b < Kernel::stencil; ++b)
+				for (int a = 0; a < Kernel::stencil; ++a) {
 					const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
 					if (N <= 0) continue;
-					const int  i = node[0][a], j = node[1][b], k = node[2][c];
-					const Real expected = grid.inDomainSupportVolume(i, j, k);
-					filling += N * (expected > 0 ? fields.water[grid.index(i, j, k)].volume / expected : 1.0);
+					const int i = node[0][a], j = node[1][b], k = node[2][c];
+					filling += N * share(grid.index(i, j, k), grid.inDomainSupportVolume(i, j, k));
 				}
 		return filling;
 	}
 
+	// A water point's filling (eq. 2.3): Σ S_I (water volume of I / full support volume of I).
+	static Real waterFilling(const GridGeometry& grid, const GridFields& fields, const Vec3& position, const Vec3& halfLength)
+	{
+		return fillingAt<GimpKernel>(grid, position, halfLength,
+		                             [&](std::size_t I, Real full) { return full > 0 ? fields.water[I].volume / full : 1.0; });
+	}
+
 	Real skeletonFilling(const GridGeometry& grid, const GridFields& fields, const Vec3& position)
 	{
-		Weights1D w[3];
-		weightsAt<LinearKernel>(grid, position, Vec3::Zero(), w);
-		int node[3][LinearKernel::stencil];
-		stencilNodes(grid, w, node);
-		Real filling = 0;
-		for (int c = 0; c < LinearKernel::stencil; ++c)
-			for (int b = 0; b < LinearKernel::stencil; ++b)
-				for (int a = 0; a < LinearKernel::stencil; ++a) {
-					const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
-					if (N <= 0) continue;
-					const int  i = node[0][a], j = node[1][b], k = node[2][c];
-					const Real full = grid.inDomainSupportVolume(i, j, k);
-					filling += N * (full > 0 ? std::min<Real>(1, fields.solid[grid.index(i, j, k)].volume / full) : 0.0);
-				}
-		return filling;
+		return fillingAt<LinearKernel>(grid, position, Vec3::Zero(),
+		                               [&](std::size_t I, Real full) { return full > 0 ? std::min<Real>(1, fields.solid[I].volume / full) : 0.0; });
 	}
 
 	// Linear least-squares fit of the pressures of the points in the 3×3×3 cells around `cell`

@@ -353,7 +353,11 @@ def test_inertia_scale_is_released_when_a_block_starts_to_slide_and_the_release_
     assert O.engines[0].inertiaScale == 1 and O.engines[0].inertiaScaleReleaseTime == pytest.approx(1e-3, rel=1e-9)
 
 
-def dry_over_wet_column(height=0.5, cell=0.05, table=0.3, corrections=0, scheme="semi-implicit"):
+def column_of_points(height, cell, **saturated):
+    """A one-cell-wide column of 2×2 points per cell layer up to `height` [m] under a free top two
+    cells above it, semi-implicit, k = 1e-3 m/s, real water; `saturated` goes to
+    yade_mpm.saturated_points (the water and its start), `engine` to MpmTwoPhaseEngine."""
+    engine = saturated.pop("engine", {})
     soil = w.MpmSoilMat(density=2650, youngModulus=20e6, poissonRatio=0.3, porosity=0.4, intrinsicPermeability=1e-10)
     water = w.MpmWaterMat(density=1000, bulkModulus=2.2e9, viscosity=1e-3)
     O.materials.append([soil, water])
@@ -361,13 +365,16 @@ def dry_over_wet_column(height=0.5, cell=0.05, table=0.3, corrections=0, scheme=
     z = spacing * (np.arange(int(round(height / spacing))) + 0.5)
     X, Y, Z = np.meshgrid(spacing * (np.arange(2) + 0.5), spacing * (np.arange(2) + 0.5), z, indexing="ij")
     positions = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
-    solid_body, water_body = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=G, surface=height, water_table=table,
-                                                       dry_above_table=True)
+    solid_body, water_body = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=G, surface=height, **saturated)
     O.bodies.append([solid_body, water_body])
-    O.engines = [w.MpmTwoPhaseEngine(gravity=G, domainMin=(0, 0, 0), domainMax=(cell, cell, cell * np.ceil(height / cell + 2)), cellSize=cell,
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm", gravity=G, domainMin=(0, 0, 0), domainMax=(cell, cell, cell * np.ceil(height / cell + 2)), cellSize=cell,
                                      solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("free",),
-                                     freeSurfaceThreshold=0.75, pressureCorrections=corrections, scheme=scheme)]
+                                     freeSurfaceThreshold=0.75, **engine)]
     return positions, solid_body.shape, water_body.shape
+
+
+def dry_over_wet_column(height=0.5, cell=0.05, table=0.3, corrections=0, scheme="semi-implicit"):
+    return column_of_points(height, cell, water_table=table, dry_above_table=True, engine=dict(pressureCorrections=corrections, scheme=scheme))
 
 
 def test_dry_above_table_start_is_geostatic():
@@ -420,19 +427,8 @@ def test_saturated_surface_between_node_planes_stays_at_rest():
 def submerged_column(height=0.275, cell=0.05, level=0.4):
     """The column of the test above (surface half a cell below a node plane) under still water at
     `level` (engine stillWaterLevel, theory.md eq. 1.9), built with saturated_points(still_water_level=)."""
-    soil = w.MpmSoilMat(density=2650, youngModulus=20e6, poissonRatio=0.3, porosity=0.4, intrinsicPermeability=1e-10)
-    water = w.MpmWaterMat(density=1000, bulkModulus=2.2e9, viscosity=1e-3)
-    O.materials.append([soil, water])
-    spacing = cell / 2
-    z = spacing * (np.arange(int(round(height / spacing))) + 0.5)
-    X, Y, Z = np.meshgrid(spacing * (np.arange(2) + 0.5), spacing * (np.arange(2) + 0.5), z, indexing="ij")
-    positions = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
-    solid_body, water_body = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=G, surface=height, still_water_level=level)
-    O.bodies.append([solid_body, water_body])
-    O.engines = [w.MpmTwoPhaseEngine(label="mpm", gravity=G, domainMin=(0, 0, 0), domainMax=(cell, cell, cell * np.ceil(height / cell + 2)), cellSize=cell,
-                                     solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("free",),
-                                     freeSurfaceThreshold=0.75, stillWaterLevel=level)]
-    return solid_body.shape, water_body.shape
+    _, solid, fluid = column_of_points(height, cell, still_water_level=level, engine=dict(stillWaterLevel=level))
+    return solid, fluid
 
 
 def test_submerged_surface_between_node_planes_stays_at_rest_and_the_level_is_saved(tmp_path):
