@@ -607,13 +607,6 @@ void TwoPhaseSolver::updateDomains()
 	for (SolidSet& s : solids_) stages::updateDomainsCpGimp(*s.points, grid_.cellSize);
 }
 
-// Water points in a sink, free water (when asked: it has left the soil, as into a filtering
-// cloth) or (when allowed) water leaving the grid leave the model; a point whose domain reaches
-// past a drained face is cut at the face, the part beyond has left (the mirror of the inflow
-// buffer, eq. 2.5: outflow is as continuous as inflow; a point removed whole when its centre
-// crossed jolted the column each time, up to 4 mm/s of skeleton speed in a k = 0.05 m/s seepage
-// column). Every mass that leaves is accounted in removedWaterMass (theory.md §2.4). Their nodal
-// mass of this step is already spent.
 bool TwoPhaseSolver::nearInflowFace(const Vec3& x) const
 {
 	for (int f = 0; f < faceCount; ++f) {
@@ -625,6 +618,13 @@ bool TwoPhaseSolver::nearInflowFace(const Vec3& x) const
 	return false;
 }
 
+// Water points in a sink, free water (when asked: it has left the soil, as into a filtering
+// cloth) or (when allowed) water leaving the grid leave the model; a point whose domain reaches
+// past a drained face is cut at the face, the part beyond has left (the mirror of the inflow
+// buffer, eq. 2.5: outflow is as continuous as inflow; a point removed whole when its centre
+// crossed jolted the column each time, up to 4 mm/s of skeleton speed in a k = 0.05 m/s seepage
+// column). Every mass that leaves is accounted in removedWaterMass (theory.md §2.4). Their nodal
+// mass of this step is already spent.
 void TwoPhaseSolver::removeOutflowingWater()
 {
 	bool drainedFace = false;

@@ -106,20 +106,20 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
             if not (np.isfinite(still_water_level) and z.max() <= still_water_level):
                 raise ValueError("still_water_level = %r m is outside the valid range [%g, inf): the highest point's elevation"
                                  % (still_water_level, z.max()))
-            water_table = still_water_level  # only to pass the check below; the pressures are excess ones
-        if surface is None or water_table is None:
+        if surface is None or (water_table is None and still_water_level is None):
             raise ValueError("a geostatic start needs the ground surface and the water table elevations [m]")
         surface = np.broadcast_to(np.asarray(surface, dtype=float), (count,))
         rho_w = water.density
         rho_sat = (1 - n0) * soil.density + n0 * rho_w
-        # hydrostatic pore pressure below the water table; above it none, or the capillary suction
-        # that holds the water at rest; the skeleton carries the total weight less the pore pressure
-        pore_pressure = rho_w * g * (float(water_table) - z)
-        if not suction_above_table:
-            pore_pressure = np.clip(pore_pressure, 0, None)
+        if still_water_level is None:
+            # hydrostatic pore pressure below the water table; above it none, or the capillary suction
+            # that holds the water at rest; the skeleton carries the total weight less the pore pressure
+            pore_pressure = rho_w * g * (float(water_table) - z)
+            if not suction_above_table:
+                pore_pressure = np.clip(pore_pressure, 0, None)
         if still_water_level is not None:
-            pore_pressure = np.zeros(count)  # excess over the still water's hydrostatic pressure
-            vertical = -(1 - n0) * (soil.density - rho_w) * g * (surface - z)  # the buoyant weight
+            # the excess over the still water's hydrostatic pressure is 0 at rest: the buoyant weight
+            vertical = -(1 - n0) * (soil.density - rho_w) * g * (surface - z)
         elif dry_above_table:
             if suction_above_table or gravity[:2].any():
                 raise ValueError("dry_above_table needs level gravity and no suction_above_table")

@@ -52,11 +52,13 @@ def test_submerged_scene_heads_start_at_the_still_water_and_are_checked():
         sandpile.pile_points(sandpile.SandPileScene(still_water_level=0.10, head_start=0.10, head_end=0.2), 0.01)
 
 
-def test_limit_equilibrium_of_the_submerged_pile_at_rest_equals_the_dry_pile():
-    """Bishop's F of a cohesionless slope with no pore pressure does not depend on the unit weight
-    (every slice's driving and resisting terms scale with it), so the submerged pile at rest (buoyant
-    weights, excess pore pressure 0: theory.md eq. 1.9) has the dry pile's F, to round-off."""
+def test_limit_equilibrium_of_the_submerged_pile_uses_buoyant_weights_and_equals_the_dry_pile_at_rest(monkeypatch):
+    """Submerged (theory.md eq. 1.9), Bishop takes the grains' buoyant weight m (1 − ρw/ρs) g, a
+    weightless water and the excess pore pressures (checked on the section it is handed). At rest
+    (excess pressure 0) a cohesionless slope's F does not depend on the unit weight, so it equals
+    the dry pile's, to round-off."""
     from types import SimpleNamespace
+    from yade_mpm import slope_stability
     cell = 0.02
     points, spacing = sandpile.pile_points(sandpile.DEFAULT, cell)
     volume = spacing ** 3
@@ -65,7 +67,13 @@ def test_limit_equilibrium_of_the_submerged_pile_at_rest_equals_the_dry_pile():
     no_water = SimpleNamespace(pos=np.zeros((0, 3)), mass=np.zeros(0), porePressure=np.zeros(0))
     at_rest = SimpleNamespace(pos=points, mass=np.full(len(points), s.porosity * s.water_density * volume), porePressure=np.zeros(len(points)))
     gravity = (0.0, 0.0, -9.81)
+    handed = []
+    section_from_points = slope_stability.section_from_points
+    monkeypatch.setattr(slope_stability, "section_from_points", lambda *a, **k: handed.append(a) or section_from_points(*a, **k))
     dry = sandpile.limit_equilibrium(sandpile.DEFAULT, solid, no_water, gravity, cell, spacing)
     submerged = sandpile.limit_equilibrium(s, solid, at_rest, gravity, cell, spacing)
+    _, solid_masses, _, water_masses, pressures = handed[1][:5]
+    assert np.allclose(solid_masses, solid.mass * (1 - s.water_density / s.grain_density), rtol=1e-15)
+    assert not np.any(water_masses) and np.array_equal(pressures, at_rest.porePressure)
     assert 1.0 < dry.factor < 1.2  # Davis' φ* = 31.9° on a 30° slope: tan φ*/tan 30° = 1.08 for a shallow slide
     assert submerged.factor == pytest.approx(dry.factor, rel=1e-9)
