@@ -65,6 +65,8 @@ parser.add_argument("--submerged", action="store_true",
                     help="the pile under still water (yade_mpm.sandpile.SUBMERGED: excess pore pressure, theory.md eq. 1.9; "
                          "semi-implicit, the head rising over a laboratory minute)")
 parser.add_argument("--head-end", type=float, help="inflow water level at the end of the rise [m] (default the scene's)")
+parser.add_argument("--base", choices=("frictional", "fixed"), default="frictional",
+                    help="the flume base: a Coulomb contact with the scene's base friction angle (default), or fixed (no slip, no lift-off)")
 parser.add_argument("--head-start", type=float, help="inflow water level at the start, also the pile's starting water table [m] (default the scene's 0.03 m)")
 args = parser.parse_args(sys.argv[1:])
 
@@ -132,8 +134,8 @@ engine = MpmTwoPhaseEngine(
     inertiaScaleRelease=args.inertia_release,
     stillWaterLevel=SCENE.still_water_level if SUBMERGED else float("-inf"),  # pore pressures are excess ones when submerged
     #            xMin (inflow)  xMax      yMin (front)   yMax (rear)    zMin (base)    zMax
-    solidWalls=("slip",        "free",   "slip",        "slip",        "frictional",  "free"),
-    wallFriction=(0,           0,        0,             0,             math.tan(SCENE.base_friction_angle), 0),
+    solidWalls=("slip",        "free",   "slip",        "slip",        args.base,     "free"),
+    wallFriction=(0,           0,        0,             0,             math.tan(SCENE.base_friction_angle) if args.base == "frictional" else 0, 0),
     waterWalls=("drained",     "free",   "impermeable", "impermeable", "impermeable", "free"),
     waterInflow=(True, False, False, False, False, False),
     drainedWaterTable=(SCENE.head_start, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE),

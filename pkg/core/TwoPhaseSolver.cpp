@@ -2,6 +2,7 @@
 
 #include "Errors.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -618,6 +619,41 @@ bool TwoPhaseSolver::nearInflowFace(const Vec3& x) const
 	return false;
 }
 
+bool TwoPhaseSolver::insideSkeleton(const Vec3& x)
+{
+	const Real h      = grid_.cellSize;
+	auto       cellOf = [&](const Vec3& y, int d) { return static_cast<long>(std::floor((y[d] - grid_.origin[d]) / h)); };
+	auto       key    = [&](long i, long j, long k) { return static_cast<std::size_t>(i + grid_.nodes[0] * (j + static_cast<long>(grid_.nodes[1]) * k)); };
+	auto       inGrid = [&](long i, long j, long k) { return i >= 0 && j >= 0 && k >= 0 && i < grid_.nodes[0] && j < grid_.nodes[1] && k < grid_.nodes[2]; };
+	if (skeletonBins_.empty()) {
+		for (std::size_t s = 0; s < solids_.size(); ++s) {
+			const SolidPointSet& P = *solids_[s].points;
+			for (std::size_t q = 0; q < P.size(); ++q) {
+				const long i = cellOf(P.position[q], 0), j = cellOf(P.position[q], 1), k = cellOf(P.position[q], 2);
+				if (inGrid(i, j, k)) skeletonBins_.push_back({ key(i, j, k), { s, q } });
+			}
+		}
+		std::sort(skeletonBins_.begin(), skeletonBins_.end());
+	}
+	// a domain that holds x has its centre within its half-length of x: the neighbouring cells hold
+	// every such centre while half-lengths stay below a cell (uGIMP h/4; cpGIMP stretched beyond h
+	// is missed, and the filling's reading stands)
+	const long ci = cellOf(x, 0), cj = cellOf(x, 1), ck = cellOf(x, 2);
+	for (long k = ck - 1; k <= ck + 1; ++k)
+		for (long j = cj - 1; j <= cj + 1; ++j)
+			for (long i = ci - 1; i <= ci + 1; ++i) {
+				if (!inGrid(i, j, k)) continue;
+				const std::size_t c     = key(i, j, k);
+				auto              first = std::lower_bound(skeletonBins_.begin(), skeletonBins_.end(), std::make_pair(c, std::make_pair(std::size_t(0), std::size_t(0))));
+				for (auto it = first; it != skeletonBins_.end() && it->first == c; ++it) {
+					const SolidPointSet& P = *solids_[it->second.first].points;
+					const std::size_t    q = it->second.second;
+					if (((x - P.position[q]).cwiseAbs() - P.halfLength[q]).maxCoeff() <= 0) return true;
+				}
+			}
+	return false;
+}
+
 // Water points in a sink, free water (when asked: it has left the soil, as into a filtering
 // cloth) or (when allowed) water leaving the grid leave the model; a point whose domain reaches
 // past a drained face is cut at the face, the part beyond has left (the mirror of the inflow
@@ -631,6 +667,7 @@ void TwoPhaseSolver::removeOutflowingWater()
 	for (int f = 0; f < faceCount; ++f) drainedFace = drainedFace || domain_.boundaries.walls[f].water == WaterWall::Drained;
 	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid && !domain_.removeFreeWater && !drainedFace && !domain_.boundaries.submerged()) return;
 	const Vec3 faceLower = grid_.lower(), faceUpper = grid_.upper();
+	skeletonBins_.clear();
 	for (WaterPointSet* w : waters_) {
 		const std::size_t n = w->size();
 		removeFlags_.assign(n, 0);
@@ -644,8 +681,11 @@ void TwoPhaseSolver::removeOutflowingWater()
 			// still water, which the model does not carry (weightless, it would pile up on the surface);
 			// not in an inflow face's cell, whose water is the reservoir's (eq. 2.5: removed there, a
 			// buffer in a loosened crest was grown again every step)
+			// The nodal filling is the cheap test; it reads a one-point-thick edge of the skeleton at
+			// ≈ 0.4 (the submerged pile's toe tip), so a point it calls out stays while its centre lies
+			// in a solid point's domain
 			out = out || (domain_.boundaries.submerged() && !nearInflowFace(w->position[p]) &&
-			              stages::skeletonFilling(grid_, fields_, w->position[p]) < submergedOutflowFilling);
+			              stages::skeletonFilling(grid_, fields_, w->position[p]) < submergedOutflowFilling && !insideSkeleton(w->position[p]));
 			// the part of a point beyond a drained face has left through it (eq. 2.4)
 			for (int f = 0; f < faceCount && !out; ++f) {
 				if (domain_.boundaries.walls[f].water != WaterWall::Drained || grid_.periodic[f / 2]) continue;
