@@ -65,6 +65,8 @@ parser.add_argument("--submerged", action="store_true",
                     help="the pile under still water (yade_mpm.sandpile.SUBMERGED: excess pore pressure, theory.md eq. 1.9; "
                          "semi-implicit, the head rising over a laboratory minute)")
 parser.add_argument("--head-end", type=float, help="inflow water level at the end of the rise [m] (default the scene's)")
+parser.add_argument("--crest-lid", action="store_true",
+                    help="an impermeable smooth lid on the crest (the flume's top at the crest height; yade_mpm.sandpile.SandPileScene.crest_lid)")
 parser.add_argument("--base", choices=("frictional", "fixed"), default="frictional",
                     help="the flume base: a Coulomb contact with the scene's base friction angle (default), or fixed (no slip, no lift-off)")
 parser.add_argument("--head-start", type=float, help="inflow water level at the start, also the pile's starting water table [m] (default the scene's 0.03 m)")
@@ -74,6 +76,8 @@ SCENE = sandpile.SUBMERGED if args.submerged else sandpile.DEFAULT
 SUBMERGED = SCENE.still_water_level is not None
 if SUBMERGED and args.scheme != "semi-implicit":
     raise ValueError("--submerged runs on --scheme semi-implicit (got %r)" % args.scheme)
+if args.crest_lid:
+    SCENE = dataclasses.replace(SCENE, crest_lid=True, flume_height=SCENE.pile_height)
 if args.ramp_time is not None or args.hold_time is not None or args.head_start is not None or args.head_end is not None:
     SCENE = dataclasses.replace(SCENE, head_ramp_time=SCENE.head_ramp_time if args.ramp_time is None else args.ramp_time,
                                 hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time,
@@ -134,9 +138,11 @@ engine = MpmTwoPhaseEngine(
     inertiaScaleRelease=args.inertia_release,
     stillWaterLevel=SCENE.still_water_level if SUBMERGED else float("-inf"),  # pore pressures are excess ones when submerged
     #            xMin (inflow)  xMax      yMin (front)   yMax (rear)    zMin (base)    zMax
-    solidWalls=("slip",        "free",   "slip",        "slip",        args.base,     "free"),
+    # zMax: open, or with a crest lid the flume's top at the crest: a smooth contact (pushes, never
+    # pulls) that the water cannot cross
+    solidWalls=("slip",        "free",   "slip",        "slip",        args.base,     "frictional" if SCENE.crest_lid else "free"),
     wallFriction=(0,           0,        0,             0,             math.tan(SCENE.base_friction_angle) if args.base == "frictional" else 0, 0),
-    waterWalls=("drained",     "free",   "impermeable", "impermeable", "impermeable", "free"),
+    waterWalls=("drained",     "free",   "impermeable", "impermeable", "impermeable", "impermeable" if SCENE.crest_lid else "free"),
     waterInflow=(True, False, False, False, False, False),
     drainedWaterTable=(SCENE.head_start, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE),
     freeSurfaceThreshold=0.75,  # the outer point layer is the pile's surface ...

@@ -60,6 +60,11 @@ class SandPileScene:
     # pile is submerged: the downstream flume holds still water at this level, the inflow head rises
     # from it, and the model solves the excess pore pressure (engine stillWaterLevel, theory.md eq. 1.9).
     still_water_level: float = None
+    # An impermeable, smooth lid on the crest [-]: the flume's top at the crest height, a contact that
+    # holds the crest down (never pulls it up) and keeps the water from leaving through it, so that
+    # the seepage leaves through the slope (a submerged crest next to the inflow face is a piping exit
+    # otherwise: the face's excess head meets the surface's p = 0 across one cell).
+    crest_lid: bool = False
 
     def toe_x(self):
         """x of the downstream toe [m]."""
@@ -97,8 +102,8 @@ class SandPileScene:
                              % (self.pile_height, self.still_water_level, self.head_start, self.head_end))
         if not (0 <= self.base_friction_angle < math.pi / 2):
             raise ValueError("base_friction_angle = %r rad is outside the valid range [0, π/2)" % self.base_friction_angle)
-        if self.pile_height >= self.flume_height:
-            raise ValueError("pile_height = %r m must be below flume_height = %r m" % (self.pile_height, self.flume_height))
+        if self.pile_height > self.flume_height or (self.pile_height == self.flume_height and not self.crest_lid):
+            raise ValueError("pile_height = %r m must be below flume_height = %r m (equal with a crest lid)" % (self.pile_height, self.flume_height))
 
 
 DEFAULT = SandPileScene()
@@ -131,13 +136,13 @@ def pile_points(scene, cell_size, points_per_cell=2):
     return np.stack([X[inside], Y[inside], Z[inside]], axis=1), spacing
 
 
-def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing):
+def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing, min_depth=None):
     """Bishop's critical circle of the pile's downstream slope on the run's current state
     (yade_mpm.slope_stability): weights from both phases' point masses, pore pressures from the
     water points, averaged over the flume's width; the sand's peak strength reduced for its
     non-associated flow by Davis (φ = 36°, ψ = 6° → φ* = 31.9°); slip circles no deeper than the
-    flume base and at least one cell deep (a thinner slide is below what the MPM resolves).
-    Returns the slope_stability.CriticalCircle (its .factor is the factor of safety)."""
+    flume base and at least min_depth deep [m] (default one cell: a thinner slide is below what the
+    MPM resolves). Returns the slope_stability.CriticalCircle (its .factor is the factor of safety)."""
     from . import slope_stability
     strength = slope_stability.Strength(cohesion=0.0, friction_angle=scene.friction_angle, dilatancy_angle=scene.dilatancy_angle).davis()
     solid_mass, water_mass = np.asarray(solid.mass), np.asarray(fluid.mass)
@@ -152,4 +157,4 @@ def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing):
     height, toe = scene.pile_height, scene.toe_x()
     return slope_stability.critical_circle(section, np.linspace(scene.crest_length, toe + 0.5 * height, 9),
                                            np.linspace(1.1 * height, 4 * height, 9), radii_per_centre=10,
-                                           min_depth=cell_size, slice_count=30)
+                                           min_depth=cell_size if min_depth is None else min_depth, slice_count=30)

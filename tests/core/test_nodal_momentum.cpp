@@ -146,4 +146,29 @@ TEST(FrictionalWall, LetsGoOnlyWhatIsPulledOffAndMovesOff)
 	EXPECT_TRUE(contactUpdate(Vec3(0.1, 0, 0.2), Vec3(0, 0, 4), 0.5, SolidWall::Fixed).isZero());
 }
 
+// The same contact as a smooth lid on the top face (zMax 'frictional', μ = 0; the sand pile's crest
+// lid): it holds a node the soil presses up against it and lets go of one whose weight pulls it
+// down, as a lid resting on a crest that may settle away from it.
+TEST(FrictionalWall, ASmoothLidHoldsWhatPressesUpAndLetsGoWhatFalls)
+{
+	GridGeometry       g = GridGeometry::forDomain(Vec3::Zero(), Vec3::Ones(), 1.0);
+	BoundaryConditions bcs;
+	bcs.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Frictional, WaterWall::Impermeable };
+	ConstrainedNodes c = ConstrainedNodes::build(g, bcs);
+	auto             update = [&](const Vec3& v, const Vec3& f) {
+		GridFields fields;
+		fields.resize(g.nodeCount());
+		const std::size_t I     = g.index(1, 1, g.upperWallNode[2]);
+		const Real        m     = 2;
+		fields.solid[I]         = SolidNode { m, m * v, f, 1, 0.6, 0 };
+		fields.solidVelocity[I] = v;
+		stages::integrateNodalMomentum(fields, c, 0.1, DragScheme::SemiImplicit, 1e-12, 1e-12);
+		return Vec3(fields.solidVelocityNew[I]);
+	};
+	const Vec3 pressedUp = update(Vec3(0.1, 0, 0.05), Vec3(0, 0, 4)); // heave: normal held, the tangential free (μ = 0)
+	EXPECT_LT((pressedUp - Vec3(0.1, 0, 0)).norm(), 1e-14);
+	const Vec3 falling = update(Vec3(0.1, 0, -0.1), Vec3(0, 0, -4)); // settling away: v + Δt f/m
+	EXPECT_LT((falling - Vec3(0.1, 0, -0.3)).norm(), 1e-14);
+}
+
 } // namespace

@@ -77,3 +77,19 @@ def test_limit_equilibrium_of_the_submerged_pile_uses_buoyant_weights_and_equals
     assert not np.any(water_masses) and np.array_equal(pressures, at_rest.porePressure)
     assert 1.0 < dry.factor < 1.2  # Davis' φ* = 31.9° on a 30° slope: tan φ*/tan 30° = 1.08 for a shallow slide
     assert submerged.factor == pytest.approx(dry.factor, rel=1e-9)
+
+
+def test_limit_equilibrium_deeper_minimum_slip_raises_the_factor_of_a_cohesionless_slope():
+    """A dry cohesionless slope is most critical at its surface (the infinite-slope limit
+    F → tan φ*/tan β as the slide thins), so forbidding the shallow circles (min_depth) can only
+    raise Bishop's factor, strictly here, where the shallowest allowed circle is the critical one.
+    The run's own pressure fields are judged with it against the depth the grid resolves."""
+    from types import SimpleNamespace
+    cell = 0.02
+    points, spacing = sandpile.pile_points(sandpile.DEFAULT, cell)
+    s = sandpile.DEFAULT
+    solid = SimpleNamespace(pos=points, mass=np.full(len(points), (1 - s.porosity) * s.grain_density * spacing ** 3))
+    no_water = SimpleNamespace(pos=np.zeros((0, 3)), mass=np.zeros(0), porePressure=np.zeros(0))
+    gravity = (0.0, 0.0, -9.81)
+    factors = [sandpile.limit_equilibrium(s, solid, no_water, gravity, cell, spacing, min_depth=d * cell).factor for d in (1, 2, 3)]
+    assert factors[0] < factors[1] < factors[2], factors
