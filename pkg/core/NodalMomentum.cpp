@@ -76,14 +76,20 @@ namespace stages {
 		}
 	}
 
-	Real skeletonInertiaRatio(const GridFields& fields, Real dt, Real gravity, Real inertiaScale, Real solidMassTolerance)
+	Real skeletonInertiaRatio(const GridFields& fields, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
+	                          Real gravity, Real inertiaScale, Real solidMassTolerance)
 	{
 		Vec3 momentumChange = Vec3::Zero();
 		Real mass           = 0;
 		for (std::size_t I = 0; I < fields.solid.size(); ++I) {
 			const Real m = fields.solid[I].mass;
 			if (!(m > solidMassTolerance)) continue;
-			momentumChange += m * (fields.solidVelocityNew[I] - fields.solidVelocity[I]);
+			Vec3      change = fields.solidVelocityNew[I] - fields.solidVelocity[I];
+			const int c      = constrained.positionOf.empty() ? -1 : constrained.positionOf[I];
+			if (c >= 0 && static_cast<std::size_t>(c) < heldSolid.size())
+				for (int d = 0; d < 3; ++d)
+					if (heldSolid[c][d]) change[d] = 0; // a wall's hold: the mapped velocity it zeroes is no inertia
+			momentumChange += m * change;
 			mass += m;
 		}
 		if (!(mass > 0 && gravity > 0 && dt > 0)) return 0;

@@ -123,8 +123,10 @@ namespace stages {
 	void scaleNodalInertia(GridFields& fields, Real inertiaScale);
 	// The net inertial force on the skeleton this step relative to its weight (eq. 4.8c):
 	// |Σ_I m_I (v^{n+1}_I − v^n_I)| / (Δt |g| Σ_I m_I / α) over the nodes with solid mass, the nodal
-	// masses m_I being the scaled ones. 0 without gravity or solid mass.
-	Real skeletonInertiaRatio(const GridFields& fields, Real dt, Real gravity, Real inertiaScale, Real solidMassTolerance);
+	// masses m_I being the scaled ones, the components a wall holds this step (`heldSolid` per
+	// constrained node) left out. 0 without gravity or solid mass.
+	Real skeletonInertiaRatio(const GridFields& fields, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
+	                          Real gravity, Real inertiaScale, Real solidMassTolerance);
 
 	// Suction-holding free surface (theory.md eq. 2.3b): marks (1) the nodes whose filling
 	// V^w_I/V^full_I is below `threshold`, that carry solid and water, and whose nodal pore

@@ -395,7 +395,7 @@ Real TwoPhaseSolver::drainageRelaxationTime() const
 
 void TwoPhaseSolver::checkQuasiStatic(Real dt)
 {
-	lastInertiaRatio_ = stages::skeletonInertiaRatio(fields_, dt, settings_.gravity.norm(), inertiaScale_, solidMassTolerance_);
+	lastInertiaRatio_ = stages::skeletonInertiaRatio(fields_, constrained_, heldSolid_, dt, settings_.gravity.norm(), inertiaScale_, solidMassTolerance_);
 	if (lastInertiaRatio_ > settings_.inertiaScaleRelease) {
 		inertiaScale_       = 1; // from the next step on; this step's motion stands as computed
 		inertiaReleaseStep_ = steps_;

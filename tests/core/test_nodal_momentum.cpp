@@ -171,4 +171,32 @@ TEST(FrictionalWall, ASmoothLidHoldsWhatPressesUpAndLetsGoWhatFalls)
 	EXPECT_LT((falling - Vec3(0.1, 0, -0.3)).norm(), 1e-14);
 }
 
+// The release ratio of the inertia scaling (eq. 4.8c) counts the skeleton's free motion only: the
+// velocity a wall zeroes at its nodes (the interior's velocity mapped onto them, e.g. a crest creeping
+// up against a lid) is the wall's hold, not inertia — it released α = 100 in the lidded sand pile at
+// 4.5 s while nothing accelerated. Two nodes of mass 1 (scaled by α = 100) on a fixed base, Δt = 0.01 s,
+// g = 10: one on the base moving down 0.001 m/s before its hold, one above accelerating by 0.1 m/s
+// sideways: R = α |m Δv| / (Δt g Σ α m) = 100 · 0.1 / (0.01 · 10 · 2) = 50 from the free one alone.
+TEST(InertiaRelease, CountsTheFreeMotionNotTheWallsHold)
+{
+	GridGeometry       g = GridGeometry::forDomain(Vec3::Zero(), Vec3::Ones(), 1.0);
+	BoundaryConditions bcs;
+	bcs.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Free };
+	ConstrainedNodes c = ConstrainedNodes::build(g, bcs);
+	GridFields       fields;
+	fields.resize(g.nodeCount());
+	const std::size_t onBase = g.index(1, 1, 1), above = g.index(1, 1, 2);
+	for (std::size_t I : { onBase, above }) fields.solid[I].mass = 100; // α m
+	fields.solidVelocity[onBase]    = Vec3(0, 0, -0.001);
+	fields.solidVelocityNew[onBase] = Vec3::Zero(); // held by the base
+	fields.solidVelocity[above]     = Vec3::Zero();
+	fields.solidVelocityNew[above]  = Vec3(0.1, 0, 0);
+	std::vector<std::array<bool, 3>> held(c.node.size(), { false, false, false });
+	held[c.positionOf[onBase]] = { true, true, true };
+	EXPECT_NEAR(stages::skeletonInertiaRatio(fields, c, held, 0.01, 10, 100, 1e-12), 50, 1e-12);
+	// a node the wall does not hold this step (a contact that let go) counts whole
+	held[c.positionOf[onBase]] = { false, false, false };
+	EXPECT_NEAR(stages::skeletonInertiaRatio(fields, c, held, 0.01, 10, 100, 1e-12), 100 * Vec3(0.1, 0, -0.001).norm() / (0.01 * 10 * 2), 1e-12);
+}
+
 } // namespace
