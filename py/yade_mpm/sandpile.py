@@ -142,7 +142,9 @@ def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing, mi
     water points, averaged over the flume's width; the sand's peak strength reduced for its
     non-associated flow by Davis (φ = 36°, ψ = 6° → φ* = 31.9°); slip circles no deeper than the
     flume base and at least min_depth deep [m] (default one cell: a thinner slide is below what the
-    MPM resolves). Returns the slope_stability.CriticalCircle (its .factor is the factor of safety)."""
+    MPM resolves); with a crest lid, only slides that break through the ground downstream of it (the
+    lid's reaction, which holds the crest down against the excess pressure, is not known to the
+    method). Returns the slope_stability.CriticalCircle (its .factor is the factor of safety)."""
     from . import slope_stability
     strength = slope_stability.Strength(cohesion=0.0, friction_angle=scene.friction_angle, dilatancy_angle=scene.dilatancy_angle).davis()
     solid_mass, water_mass = np.asarray(solid.mass), np.asarray(fluid.mass)
@@ -157,4 +159,5 @@ def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing, mi
     height, toe = scene.pile_height, scene.toe_x()
     return slope_stability.critical_circle(section, np.linspace(scene.crest_length, toe + 0.5 * height, 9),
                                            np.linspace(1.1 * height, 4 * height, 9), radii_per_centre=10,
-                                           min_depth=cell_size if min_depth is None else min_depth, slice_count=30)
+                                           min_depth=cell_size if min_depth is None else min_depth, slice_count=30,
+                                           free_ground=(scene.crest_length, math.inf) if scene.crest_lid else None)

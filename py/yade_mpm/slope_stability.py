@@ -136,10 +136,11 @@ def slices_of_surface(section, slip_x, slip_z, count=40):
     return _build_slices(section, edges, lambda x: np.interp(x, slip_x, slip_z), None)
 
 
-def slices_of_circle(section, centre, radius, count=40, min_depth=0.0):
+def slices_of_circle(section, centre, radius, count=40, min_depth=0.0, free_ground=None):
     """Slices of the circle (centre (x, z) [m], radius [m]) where it runs below the ground surface
     (clipped by section.base_z), or None where it does not cut a sliding mass deeper than
-    min_depth [m] or leaves the section's ends."""
+    min_depth [m], leaves the section's ends, or breaks through the ground outside free_ground
+    ((x_lo, x_hi) [m], section frame; None: anywhere)."""
     xc, zc = centre
     x_lo = max(xc - radius, section.surface_x[0])
     x_hi = min(xc + radius, section.surface_x[-1])
@@ -172,6 +173,8 @@ def slices_of_circle(section, centre, radius, count=40, min_depth=0.0):
     # entry and exit where the depth crosses zero (linear between samples)
     x_in = x[lo - 1] + (x[lo] - x[lo - 1]) * (-depth[lo - 1]) / (depth[lo] - depth[lo - 1])
     x_out = x[hi] + (x[hi + 1] - x[hi]) * depth[hi] / (depth[hi] - depth[hi + 1])
+    if free_ground is not None and not (free_ground[0] <= x_in and x_out <= free_ground[1]):
+        return None
     edges = np.linspace(x_in, x_out, count + 1)
     return _build_slices(section, edges, base, (xc, zc))
 
@@ -334,7 +337,7 @@ def _corners(section, min_turn=math.radians(5)):
 
 
 def critical_circle(section, centres_x, centres_z, radii_per_centre=12, min_depth=0.0, slice_count=30,
-                    method=bishop_simplified, zooms=3):
+                    method=bishop_simplified, zooms=3, free_ground=None):
     """Search for the circle of smallest factor of safety: every centre (x, z) of the grid
     centres_x × centres_z [m] with radii_per_centre radii from the circle that first cuts the ground
     to the one tangent to section.base_z (or reaching as deep below the ground's lowest point as
@@ -342,6 +345,8 @@ def critical_circle(section, centres_x, centres_z, radii_per_centre=12, min_dept
     slope's critical circle passes through its toe); circles shallower than min_depth [m] are
     skipped (a cohesionless slope's critical surface is otherwise its skin). Then `zooms` times a
     grid of 7 × 7 centres one spacing around the best, the spacing and radius step shrunk 3×.
+    free_ground (x_lo, x_hi) [m]: the stretch of ground surface (section frame) a slide may break
+    through at both ends, e.g. outside a lid whose reaction the method does not know; None: anywhere.
     method: bishop_simplified or spencer (its F is taken)."""
     section.validate()
     if not radii_per_centre >= 1:
@@ -367,7 +372,7 @@ def critical_circle(section, centres_x, centres_z, radii_per_centre=12, min_dept
                 radii = np.concatenate([np.linspace(r_min, r_max, radii_per_centre + 1)[1:],
                                         np.hypot(corner_x - xc, corner_z - zc) * (1 + 1e-9)])
                 for radius in radii[(radii > r_min) & (radii <= r_max)]:
-                    slices = slices_of_circle(section, (xc, zc), radius, slice_count, min_depth)
+                    slices = slices_of_circle(section, (xc, zc), radius, slice_count, min_depth, free_ground)
                     if slices is None:
                         continue
                     searched += 1
@@ -379,7 +384,8 @@ def critical_circle(section, centres_x, centres_z, radii_per_centre=12, min_dept
     xs, zs = np.atleast_1d(np.asarray(centres_x, dtype=float)), np.atleast_1d(np.asarray(centres_z, dtype=float))
     scan(xs, zs, None)
     if best is None:
-        raise ValueError("critical_circle: no circle of the search grid cuts a sliding mass deeper than min_depth = %r m" % min_depth)
+        raise ValueError("critical_circle: no circle of the search grid cuts a sliding mass deeper than min_depth = %r m%s"
+                         % (min_depth, "" if free_ground is None else " breaking through the ground within free_ground = %r m" % (tuple(free_ground),)))
     dx = np.ptp(xs) / max(xs.size - 1, 1) if xs.size > 1 else 0.1 * (ground_z.max() - bottom)
     dz = np.ptp(zs) / max(zs.size - 1, 1) if zs.size > 1 else 0.1 * (ground_z.max() - bottom)
     dr = (ground_z.max() - bottom) / radii_per_centre

@@ -128,3 +128,19 @@ def test_section_from_points_reproduces_the_closed_form_section():
     # both leave the slope where the seepage face is, within two bins of each other
     exits = [c.surface()[0].max() for c in (a, b)]
     assert abs(exits[0] - exits[1]) <= 4 * spacing, exits
+
+
+def test_free_ground_keeps_the_slides_that_break_through_it_and_can_only_raise_the_factor():
+    """A stretch of ground the slide may not break through (free_ground, e.g. the sand pile's crest
+    under a lid): every circle the search keeps enters and leaves the ground inside the free
+    stretch, and removing mechanisms can only raise the critical factor. The 60° Taylor slope's toe
+    circle enters the crest behind the slope (x < 0): with the crest closed (free ground x ≥ 0, the
+    slope face and the toe beyond) it cannot, and the critical F rises."""
+    height, gamma, cohesion = 10.0, 20e3, 40e3
+    section = simple_slope(height, 60, gamma, lem.Strength(cohesion=cohesion, friction_angle=0.0))
+    free = refined_critical_circle(section, height)
+    closed = lem.critical_circle(section, np.linspace(-0.8 * height, 1.6 * height, 13), np.linspace(1.05 * height, 3 * height, 11),
+                                 radii_per_centre=12, slice_count=60, free_ground=(0.0, math.inf))
+    assert free.surface()[0].min() < 0  # the unrestricted critical circle breaks through the crest
+    edges = closed.slices.x - 0.5 * closed.slices.width, closed.slices.x + 0.5 * closed.slices.width
+    assert edges[0].min() >= -1e-9 and closed.factor > free.factor
