@@ -24,7 +24,8 @@ Writes to DIR (default examples/sandpile/out[-quick]):
   time_series.csv                 the same numbers
   summary.json                    failure head and time, kinematic onset (onset_head_m), run-out
                                   (runout_m), deposit profile, mobilised volume, sliding surface,
-                                  limit-equilibrium onset head (lem_onset_head_m), water balance
+                                  limit-equilibrium onset heads (lem_onset_head_m; lem_deep_onset_head_m
+                                  for slides ≥ 3 cells deep), water balance
                                   (injected_kg, removed_kg, relative_residual), run time
 The water mass balance (initial + injected = stored + removed) is checked at every record; the run
 stops with an error if it fails to close to 1e-9. If the solver stops the run as unstable (a point
@@ -95,6 +96,9 @@ FAILURE_DISPLACEMENT = 0.01 * SCENE.pile_height  # mean displacement of the lowe
 # plastic shear strain that marks a point as part of the shear band: ten softening scales, where the
 # sand has reached its critical state (φ within e⁻¹⁰ of φ_r) [-]
 BAND_STRAIN = 10 * SCENE.softening_strain
+# the depth [cells] of a slide the grid resolves as a band: Bishop's check is also run on circles at
+# least this deep, next to the shallowest ones the grid can show at all (one cell)
+DEEP_SLIDE_CELLS = 3
 BALANCE_TOLERANCE = 1e-9  # relative water mass balance residual that stops the run [-]
 if not 0 < CELL <= SCENE.pile_height / 4:
     raise ValueError("--cell = %r m is outside the valid range (0, %g] (at least 4 cells over the pile height)" % (CELL, SCENE.pile_height / 4))
@@ -203,7 +207,7 @@ O.stopAtTime = DURATION  # the end of the head history; also what the progress E
 steps_per_record = int(round(RECORD_INTERVAL / O.dt))
 records_per_frame = int(round(FIELD_INTERVAL / RECORD_INTERVAL))
 rows, snapshots = [], {}
-lem_records = []  # (time, head, CriticalCircle) of each limit-equilibrium evaluation
+lem_records = []  # (time, head, critical circle, critical circle ≥ DEEP_SLIDE_CELLS deep or None) of each limit-equilibrium evaluation
 failure = None
 settled = None
 stopped = None  # the solver's message if the run went unstable: what was recorded up to then is kept
@@ -239,8 +243,12 @@ while O.time < DURATION - 1e-12:
     row["lem_factor_of_safety"] = float("nan")
     if (record - 1) % records_per_frame == 0:
         circle = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing)
+        try:
+            deep = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing, min_depth=DEEP_SLIDE_CELLS * CELL)
+        except ValueError:  # no circle that deep fits the pile: no such mechanism
+            deep = None
         row["lem_factor_of_safety"] = circle.factor
-        lem_records.append((O.time, row["head_m"], circle))
+        lem_records.append((O.time, row["head_m"], circle, deep))
     rows.append(row)
     if settled is None and O.time >= SCENE.settle_time - 1e-9:
         settled = dict(row)
@@ -286,17 +294,25 @@ if len(surface_x):
                "passes_through_toe_region": bool(abs(surface_x.max() - toe) <= 2 * CELL and surface_z[np.argmax(surface_x)] <= 2 * CELL)}
 
 # --- limit equilibrium: the head at which Bishop's factor of safety first falls below 1 -----------
-lem_onset = None
-for (t0, h0, c0), (t1, h1, c1) in zip(lem_records, lem_records[1:]):
-    if c0.factor >= 1 > c1.factor:
-        w = (c0.factor - 1) / (c0.factor - c1.factor)  # linear between the two evaluations
-        lem_onset = {"time_s": t0 + w * (t1 - t0), "head_m": h0 + w * (h1 - h0), "centre_m": list(c1.centre), "radius_m": c1.radius}
-        break
+def lem_crossing(which):
+    """Where the factor of the circles `which` (2: shallowest, 3: deep) first falls below 1, linear
+    between two evaluations; None if it never does."""
+    for r0, r1 in zip(lem_records, lem_records[1:]):
+        (t0, h0), (t1, h1), c0, c1 = r0[:2], r1[:2], r0[which], r1[which]
+        if c0 is not None and c1 is not None and c0.factor >= 1 > c1.factor:
+            w = (c0.factor - 1) / (c0.factor - c1.factor)
+            return {"time_s": t0 + w * (t1 - t0), "head_m": h0 + w * (h1 - h0), "centre_m": list(c1.centre), "radius_m": c1.radius}
+    return None
+
+
+lem_onset, lem_deep_onset = lem_crossing(2), lem_crossing(3)
 lem_summary = {"method": "Bishop simplified, critical circle (yade_mpm.slope_stability)",
                "strength": "c = 0, Davis (1968) for φ = %.0f°, ψ = %.0f°" % (math.degrees(SCENE.friction_angle), math.degrees(SCENE.dilatancy_angle)),
                "times_s": [r[0] for r in lem_records], "heads_m": [r[1] for r in lem_records],
                "factors": [r[2].factor for r in lem_records], "onset": lem_onset,
-               "lem_onset_head_m": None if lem_onset is None else lem_onset["head_m"]}
+               "lem_onset_head_m": None if lem_onset is None else lem_onset["head_m"],
+               "deep_min_depth_m": DEEP_SLIDE_CELLS * CELL, "deep_factors": [None if r[3] is None else r[3].factor for r in lem_records], "deep_onset": lem_deep_onset,
+               "lem_deep_onset_head_m": None if lem_deep_onset is None else lem_deep_onset["head_m"]}
 
 # --- kinematic onset, run-out, deposit ---------------------------------------------------------------
 # Under a rising head the onset is where the slope face's displacement grows ten times faster with
@@ -344,6 +360,7 @@ summary = {
     "kinetic_onset": kinetic,
     "onset_head_m": None if onset is None else onset["head_m"],
     "lem_onset_head_m": lem_summary["lem_onset_head_m"],
+    "lem_deep_onset_head_m": lem_summary["lem_deep_onset_head_m"],
     "runout_m": runout,
     "mobilised_volume_m3": mobilised,
     "mobilised_fraction": mobilised_fraction,
@@ -415,7 +432,7 @@ if len(surface_x):
     ax.plot(surface_x, surface_z, "c-", lw=2, label="sliding surface (base of the band κ > %.2f)" % BAND_STRAIN)
 if lem_records:  # the critical circle at the LEM onset, or where F was lowest
     below = [r for r in lem_records if r[2].factor < 1]
-    t_c, h_c, circle = below[0] if below else min(lem_records, key=lambda r: r[2].factor)
+    t_c, h_c, circle = (below[0] if below else min(lem_records, key=lambda r: r[2].factor))[:3]
     ax.plot(*circle.surface(), "g--", lw=1.5, label="Bishop's critical circle, F = %.2f at t = %.2f s" % (circle.factor, t_c))
 if len(surface_x) or lem_records:
     ax.legend(fontsize=8, loc="upper right")
@@ -438,6 +455,7 @@ a3.axhline(1e3 * FAILURE_DISPLACEMENT, color="r", ls=":", label="failure criteri
 a3.set_ylabel("displacement [mm]")
 a3.legend(fontsize=7)
 a4.plot([r[0] for r in lem_records], [r[2].factor for r in lem_records], "o-", label="Bishop, Davis strength, run's own p")
+a4.plot([r[0] for r in lem_records], [math.nan if r[3] is None else r[3].factor for r in lem_records], "s--", label="the same, slides ≥ %d cells deep" % DEEP_SLIDE_CELLS)
 a4.axhline(1, color="k", lw=0.8)
 a4.set_ylabel("LEM factor of safety [-]")
 a4.set_xlabel("t [s]")
@@ -448,5 +466,5 @@ if failure:
 fig.tight_layout()
 fig.savefig(os.path.join(OUT, "time_series.png"), dpi=110)
 print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "stopped_unstable", "failure", "sliding_surface", "water_mass_balance", "stable_before_rise")}, indent=2))
-print(json.dumps({k: lem_summary[k] for k in ("lem_onset_head_m", "factors")}))
+print(json.dumps({k: lem_summary[k] for k in ("lem_onset_head_m", "factors", "lem_deep_onset_head_m", "deep_factors")}))
 print(json.dumps({k: summary[k] for k in ("onset", "kinetic_onset", "runout_m", "mobilised_fraction")}))
