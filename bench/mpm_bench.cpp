@@ -109,5 +109,11 @@ int main(int argc, char** argv)
 	            1024.0 * (rssAfter - rssBefore) / n, dt, simulated[simulated.size() / 2], static_cast<double>(iterations) / (steps * repeats));
 	for (int i = 0; i < static_cast<int>(Stage::Count); ++i) std::printf("\t%s=%.1f", stageName(static_cast<Stage>(i)), 100 * (after[i] - before[i]) / total);
 	std::printf("\n");
+	if (std::getenv("MPM_BENCH_FINGERPRINT")) { // the final state, to compare builds (scripts/check-native.sh)
+		double sum = 0;
+		for (std::size_t p = 0; p < n; ++p) sum += solid.position[p].sum() + 1e-6 * solid.effectiveStress[p].sum();
+		for (std::size_t p = 0; p < fluid.size(); ++p) sum += 1e-6 * fluid.porePressure[p] + fluid.velocity[p].sum();
+		std::fprintf(stderr, "fingerprint %.17g\n", sum);
+	}
 	return 0;
 }
