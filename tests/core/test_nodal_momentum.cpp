@@ -88,14 +88,26 @@ TEST(ExplicitDrag, StableBelowTwoOverLambdaUnstableAbove)
 	EXPECT_LT(relativeAmplification(100.0, DragScheme::SemiImplicit), 1e-6);
 }
 
+// One cell on a fixed base (zMin): its grid, the walls' constrained nodes and empty nodal fields.
+struct OnFixedBase {
+	GridGeometry     g = GridGeometry::forDomain(Vec3::Zero(), Vec3::Ones(), 1.0);
+	ConstrainedNodes c;
+	GridFields       fields;
+	OnFixedBase()
+	{
+		BoundaryConditions bcs;
+		bcs.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Free };
+		c = ConstrainedNodes::build(g, bcs);
+		fields.resize(g.nodeCount());
+	}
+};
+
 TEST(Walls, HeldSolidComponentReSolvesTheWaterWithDragToIt)
 {
-	GridGeometry       g = GridGeometry::forDomain(Vec3::Zero(), Vec3::Ones(), 1.0);
-	BoundaryConditions bcs;
-	bcs.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Free };
-	ConstrainedNodes c = ConstrainedNodes::build(g, bcs);
-	GridFields       fields;
-	fields.resize(g.nodeCount());
+	OnFixedBase       cell;
+	GridGeometry&     g = cell.g;
+	ConstrainedNodes& c = cell.c;
+	GridFields&       fields = cell.fields;
 	const std::size_t I = g.index(1, 1, 1); // on the base wall
 	const Real        Q = 7, mw = 0.5, dt = 1e-2;
 	fields.solid[I]     = SolidNode { 2.0, 2.0 * vs0, fs, 1, 0.6, Q };
@@ -179,12 +191,10 @@ TEST(FrictionalWall, ASmoothLidHoldsWhatPressesUpAndLetsGoWhatFalls)
 // sideways: R = α |m Δv| / (Δt g Σ α m) = 100 · 0.1 / (0.01 · 10 · 2) = 50 from the free one alone.
 TEST(InertiaRelease, CountsTheFreeMotionNotTheWallsHold)
 {
-	GridGeometry       g = GridGeometry::forDomain(Vec3::Zero(), Vec3::Ones(), 1.0);
-	BoundaryConditions bcs;
-	bcs.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Free };
-	ConstrainedNodes c = ConstrainedNodes::build(g, bcs);
-	GridFields       fields;
-	fields.resize(g.nodeCount());
+	OnFixedBase       cell;
+	GridGeometry&     g = cell.g;
+	ConstrainedNodes& c = cell.c;
+	GridFields&       fields = cell.fields;
 	const std::size_t onBase = g.index(1, 1, 1), above = g.index(1, 1, 2);
 	for (std::size_t I : { onBase, above }) fields.solid[I].mass = 100; // α m
 	fields.solidVelocity[onBase]    = Vec3(0, 0, -0.001);
