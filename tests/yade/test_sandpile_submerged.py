@@ -28,13 +28,18 @@ def test_submerged_pile_stands_at_the_still_level(submerged_run):
     """At the still level there is no seepage: elastic settlement only (γ′H²/E ≈ 1 µm; measured
     2.3 µm at 1 s), the inertia scale is not released, and Bishop's F on the run's own state is the
     dry pile's (Davis φ* = 31.9° on a 30° slope: measured 1.085) — the at-rest submerged slope
-    stands by its strength, as the scene intends."""
+    stands by its strength, as the scene intends; deeper slides by a wider margin."""
     s = submerged_run
     assert s["stopped_unstable"] is None
     before = s["stable_before_rise"]
     assert abs(before["toe_displacement_m"]) < 1e-5 and abs(before["face_displacement_m"]) < 1e-5
     assert s["inertia_scale_release_time_s"] is None
     assert s["limit_equilibrium"]["factors"][0] > 1
+    # a cohesionless slope at rest is most critical at its skin: slides at least three cells deep
+    # (the depth the grid resolves as a band) stand by a wider margin (measured 1.32 against 1.09)
+    lem = s["limit_equilibrium"]
+    assert lem["deep_min_depth_m"] == pytest.approx(3 * s["cell_size_m"])
+    assert lem["deep_factors"][0] > lem["factors"][0]
 
 
 def test_submerged_pile_water_balance_closes(submerged_run):
