@@ -78,7 +78,7 @@ SUBMERGED = SCENE.still_water_level is not None
 if SUBMERGED and args.scheme != "semi-implicit":
     raise ValueError("--submerged runs on --scheme semi-implicit (got %r)" % args.scheme)
 if args.crest_lid:
-    SCENE = dataclasses.replace(SCENE, crest_lid=True, flume_height=SCENE.pile_height)
+    SCENE = dataclasses.replace(SCENE, crest_lid=True)
 if args.ramp_time is not None or args.hold_time is not None or args.head_start is not None or args.head_end is not None:
     SCENE = dataclasses.replace(SCENE, head_ramp_time=SCENE.head_ramp_time if args.ramp_time is None else args.ramp_time,
                                 hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time,
@@ -134,7 +134,7 @@ start_positions = solid.pos.copy()
 # --- engine: flume walls, inflow face, free surface, filtering cloth --------------------------------
 NO_TABLE = float("-inf")
 engine = MpmTwoPhaseEngine(
-    label="mpm", gravity=GRAVITY, domainMin=(0, 0, 0), domainMax=(SCENE.flume_length, SCENE.flume_width, SCENE.flume_height),
+    label="mpm", gravity=GRAVITY, domainMin=(0, 0, 0), domainMax=(SCENE.flume_length, SCENE.flume_width, SCENE.domain_height()),
     cellSize=CELL, shapeFunction="uGIMP",
     # by default the pile still runs on the explicit scheme with its relaxations (theory.md eqs.
     # 4.17b-c, 2.3b); porting it to the semi-implicit scheme is the sand-pile issue's work

@@ -654,6 +654,13 @@ bool TwoPhaseSolver::insideSkeleton(const Vec3& x)
 	return false;
 }
 
+bool TwoPhaseSolver::skeletonHolds(const Vec3& x)
+{
+	// the nodal filling is the cheap test; it reads a one-point-thick edge of the skeleton at ≈ 0.4
+	// (the submerged pile's toe tip), so where it says no, a solid point's domain around x decides
+	return stages::skeletonFilling(grid_, fields_, x) >= submergedOutflowFilling || insideSkeleton(x);
+}
+
 // Water points in a sink, free water (when asked: it has left the soil, as into a filtering
 // cloth) or (when allowed) water leaving the grid leave the model; a point whose domain reaches
 // past a drained face is cut at the face, the part beyond has left (the mirror of the inflow
@@ -667,7 +674,7 @@ void TwoPhaseSolver::removeOutflowingWater()
 	for (int f = 0; f < faceCount; ++f) drainedFace = drainedFace || domain_.boundaries.walls[f].water == WaterWall::Drained;
 	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid && !domain_.removeFreeWater && !drainedFace && !domain_.boundaries.submerged()) return;
 	const Vec3 faceLower = grid_.lower(), faceUpper = grid_.upper();
-	skeletonBins_.clear();
+	skeletonBins_.clear(); // the solid points have moved; injectInflowingWater, next, reuses the bins
 	for (WaterPointSet* w : waters_) {
 		const std::size_t n = w->size();
 		removeFlags_.assign(n, 0);
@@ -681,11 +688,7 @@ void TwoPhaseSolver::removeOutflowingWater()
 			// still water, which the model does not carry (weightless, it would pile up on the surface);
 			// not in an inflow face's cell, whose water is the reservoir's (eq. 2.5: removed there, a
 			// buffer in a loosened crest was grown again every step)
-			// The nodal filling is the cheap test; it reads a one-point-thick edge of the skeleton at
-			// ≈ 0.4 (the submerged pile's toe tip), so a point it calls out stays while its centre lies
-			// in a solid point's domain
-			out = out || (domain_.boundaries.submerged() && !nearInflowFace(w->position[p]) &&
-			              stages::skeletonFilling(grid_, fields_, w->position[p]) < submergedOutflowFilling && !insideSkeleton(w->position[p]));
+			out = out || (domain_.boundaries.submerged() && !nearInflowFace(w->position[p]) && !skeletonHolds(w->position[p]));
 			// the part of a point beyond a drained face has left through it (eq. 2.4)
 			for (int f = 0; f < faceCount && !out; ++f) {
 				if (domain_.boundaries.walls[f].water != WaterWall::Drained || grid_.periodic[f / 2]) continue;
@@ -834,7 +837,7 @@ void TwoPhaseSolver::injectInflowingWater()
 				x[axis] = plane + inward * 0.5 * s; // a regular point on the face's first spacing
 				if (!wall.belowWaterTable(x, settings_.gravity) || x[a1] > upper[a1] || x[a2] > upper[a2]) continue;
 				// under still water, only where the skeleton holds it (else it would leave at once, eq. 1.9)
-				if (domain_.boundaries.submerged() && stages::skeletonFilling(grid_, fields_, x) < submergedOutflowFilling) continue;
+				if (domain_.boundaries.submerged() && !skeletonHolds(x)) continue;
 				const std::size_t q = w->appendCopyOf(static_cast<std::size_t>(neighbour));
 				w->position[q]      = x; // with its neighbour's velocity, as a buffer takes its row's
 				w->porePressure[q]  = wall.drainedPressureAt(x, settings_.gravity, water_.density, domain_.boundaries.stillWaterLevel);

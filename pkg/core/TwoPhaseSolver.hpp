@@ -193,9 +193,11 @@ private:
 	TimeStepLimits                lastLimits_ {};
 	void                          removeOutflowingWater();
 	bool                          nearInflowFace(const Vec3& x) const; // within a cell of a face with waterInflow
-	// Whether x lies in a solid point's domain (eq. 1.9's outflow rule, where the skeleton's nodal
-	// filling misreads a thin edge); the solid points binned by the cell of their centre on first use
-	// after `skeletonBins_.clear()`
+	// Whether the skeleton holds water at x under still water (eq. 1.9: the outflow and the inflow
+	// face's wetting): its nodal filling at x is at least ½, or x lies in a solid point's domain
+	bool                          skeletonHolds(const Vec3& x);
+	// Whether x lies in a solid point's domain; the solid points binned by the cell of their centre on
+	// first use after `skeletonBins_.clear()`
 	bool                          insideSkeleton(const Vec3& x);
 	std::vector<std::pair<std::size_t, std::pair<std::size_t, std::size_t>>> skeletonBins_; // (cell, (set, point)), sorted
 	std::vector<char>             removeFlags_;

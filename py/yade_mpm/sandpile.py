@@ -60,11 +60,16 @@ class SandPileScene:
     # pile is submerged: the downstream flume holds still water at this level, the inflow head rises
     # from it, and the model solves the excess pore pressure (engine stillWaterLevel, theory.md eq. 1.9).
     still_water_level: float = None
-    # An impermeable, smooth lid on the crest [-]: the flume's top at the crest height, a contact that
+    # An impermeable, smooth lid on the crest [-]: the model's top at the crest height (domain_height), a contact that
     # holds the crest down (never pulls it up) and keeps the water from leaving through it, so that
     # the seepage leaves through the slope (a submerged crest next to the inflow face is a piping exit
     # otherwise: the face's excess head meets the surface's p = 0 across one cell).
     crest_lid: bool = False
+
+    def domain_height(self):
+        """Height of the model's domain above the base [m]: the crest with a crest lid (the lid is
+        the domain's top face), else the flume's height."""
+        return self.pile_height if self.crest_lid else self.flume_height
 
     def toe_x(self):
         """x of the downstream toe [m]."""
@@ -102,8 +107,8 @@ class SandPileScene:
                              % (self.pile_height, self.still_water_level, self.head_start, self.head_end))
         if not (0 <= self.base_friction_angle < math.pi / 2):
             raise ValueError("base_friction_angle = %r rad is outside the valid range [0, π/2)" % self.base_friction_angle)
-        if self.pile_height > self.flume_height or (self.pile_height == self.flume_height and not self.crest_lid):
-            raise ValueError("pile_height = %r m must be below flume_height = %r m (equal with a crest lid)" % (self.pile_height, self.flume_height))
+        if self.pile_height >= self.flume_height:
+            raise ValueError("pile_height = %r m must be below flume_height = %r m" % (self.pile_height, self.flume_height))
 
 
 DEFAULT = SandPileScene()
