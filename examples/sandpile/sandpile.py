@@ -68,10 +68,16 @@ parser.add_argument("--submerged", action="store_true",
 parser.add_argument("--head-end", type=float, help="inflow water level at the end of the rise [m] (default the scene's)")
 parser.add_argument("--crest-lid", action="store_true",
                     help="an impermeable smooth lid on the crest (the flume's top at the crest height; yade_mpm.sandpile.SandPileScene.crest_lid)")
+parser.add_argument("--lid-friction", type=float, default=0.0,
+                    help="Coulomb friction coefficient μ ≥ 0 of the crest lid (default 0, smooth; tan φ of the sand makes it rough)")
 parser.add_argument("--base", choices=("frictional", "fixed"), default="frictional",
                     help="the flume base: a Coulomb contact with the scene's base friction angle (default), or fixed (no slip, no lift-off)")
 parser.add_argument("--head-start", type=float, help="inflow water level at the start, also the pile's starting water table [m] (default the scene's 0.03 m)")
 args = parser.parse_args(sys.argv[1:])
+if not args.lid_friction >= 0:
+    raise SystemExit("--lid-friction must be ≥ 0 (a Coulomb coefficient); got %r" % args.lid_friction)
+if args.lid_friction > 0 and not args.crest_lid:
+    raise SystemExit("--lid-friction %r needs --crest-lid (there is no lid without it)" % args.lid_friction)
 
 SCENE = sandpile.SUBMERGED if args.submerged else sandpile.DEFAULT
 SUBMERGED = SCENE.still_water_level is not None
@@ -145,7 +151,7 @@ engine = MpmTwoPhaseEngine(
     # zMax: open, or with a crest lid the flume's top at the crest: a smooth contact (pushes, never
     # pulls) that the water cannot cross
     solidWalls=("slip",        "free",   "slip",        "slip",        args.base,     "frictional" if SCENE.crest_lid else "free"),
-    wallFriction=(0,           0,        0,             0,             math.tan(SCENE.base_friction_angle) if args.base == "frictional" else 0, 0),
+    wallFriction=(0,           0,        0,             0,             math.tan(SCENE.base_friction_angle) if args.base == "frictional" else 0, args.lid_friction),
     waterWalls=("drained",     "free",   "impermeable", "impermeable", "impermeable", "impermeable" if SCENE.crest_lid else "free"),
     waterInflow=(True, False, False, False, False, False),
     drainedWaterTable=(SCENE.head_start, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE),
