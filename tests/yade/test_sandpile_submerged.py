@@ -47,3 +47,16 @@ def test_submerged_pile_water_balance_closes(submerged_run):
     """The excess-pressure run keeps every water point's mass accounted for (stored + removed =
     initial + injected) to 1e-9."""
     assert abs(submerged_run["relative_residual"]) < 1e-9
+
+
+@pytest.mark.parametrize("flags, message", [(["--crest-lid", "--lid-friction", "-0.1"], "--lid-friction must be ≥ 0"),
+                                            (["--lid-friction", "0.5"], "--lid-friction 0.5 needs --crest-lid")])
+def test_lid_friction_is_refused_before_any_work(tmp_path, flags, message):
+    """A negative Coulomb coefficient has no meaning, and a lid friction without a lid would be
+    silently ignored: both stop at once with the flag's name, value and what is valid."""
+    done = subprocess.run(["yade-double", "-n", "-x", os.path.join(ROOT, "examples", "sandpile", "sandpile.py"), "--quick", "--submerged",
+                           "--scheme", "semi-implicit", "--out", str(tmp_path)] + flags,
+                          capture_output=True, text=True, timeout=120, env=dict(os.environ, HOME=str(tmp_path)), stdin=subprocess.DEVNULL)
+    assert done.returncode != 0
+    assert message in done.stdout + done.stderr
+    assert not (tmp_path / "summary.json").exists()
