@@ -67,7 +67,7 @@ parser.add_argument("--submerged", action="store_true",
                          "semi-implicit, the head rising over a laboratory minute)")
 parser.add_argument("--head-end", type=float, help="inflow water level at the end of the rise [m] (default the scene's)")
 parser.add_argument("--crest-lid", action="store_true",
-                    help="an impermeable smooth lid on the crest (the flume's top at the crest height; yade_mpm.sandpile.SandPileScene.crest_lid)")
+                    help="an impermeable lid on the crest, smooth unless --lid-friction (the domain's top at the crest height; yade_mpm.sandpile.SandPileScene.crest_lid)")
 parser.add_argument("--lid-friction", type=float, default=0.0,
                     help="Coulomb friction coefficient μ ≥ 0 of the crest lid (default 0, smooth; tan φ of the sand makes it rough)")
 parser.add_argument("--base", choices=("frictional", "fixed"), default="frictional",
@@ -148,8 +148,8 @@ engine = MpmTwoPhaseEngine(
     inertiaScaleRelease=args.inertia_release,
     stillWaterLevel=SCENE.still_water_level if SUBMERGED else float("-inf"),  # pore pressures are excess ones when submerged
     #            xMin (inflow)  xMax      yMin (front)   yMax (rear)    zMin (base)    zMax
-    # zMax: open, or with a crest lid the flume's top at the crest: a smooth contact (pushes, never
-    # pulls) that the water cannot cross
+    # zMax: open, or with a crest lid the domain's top at the crest: a Coulomb contact (pushes, never
+    # pulls; μ = --lid-friction, smooth by default) that the water cannot cross
     solidWalls=("slip",        "free",   "slip",        "slip",        args.base,     "frictional" if SCENE.crest_lid else "free"),
     wallFriction=(0,           0,        0,             0,             math.tan(SCENE.base_friction_angle) if args.base == "frictional" else 0, args.lid_friction),
     waterWalls=("drained",     "free",   "impermeable", "impermeable", "impermeable", "impermeable" if SCENE.crest_lid else "free"),
