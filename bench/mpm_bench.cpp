@@ -3,7 +3,7 @@
 // seconds per wall second, CG iterations per step, and the share of each stage. A soil point is one
 // solid point with its water point.
 //
-// Usage: mpm_bench CELLS_PER_SIDE|column STEPS REPEATS [dry] [explicit] [corrected] [linear]
+// Usage: mpm_bench CELLS_PER_SIDE|column STEPS REPEATS [dry] [explicit] [corrected] [linear] [uncached]
 // CELLS_PER_SIDE: a saturated 3D block under gravity and a sudden 10 kPa on its top, two point sets
 // (solid + water, 2×2×2 each per cell), cell averaging, at 0.5 × the scheme's critical step.
 // `column`: the reference two-phase MPM's 3D consolidation column (cb-geo/mpm-benchmarks
@@ -13,7 +13,8 @@
 // Options: `explicit`: the explicit scheme with semi-implicit drag and its pressure-mode damping (the
 // block then takes Kw = 2.2e8 Pa, as the explicit sand pile); `corrected`: two defect corrections of
 // the pressure per step (pressureCorrections = 2, theory.md eq. 8.7b); `dry`: solid points only (the
-// soil-point column then counts solid points); `linear`: linear shape functions instead of uGIMP.
+// soil-point column then counts solid points); `linear`: linear shape functions instead of uGIMP;
+// `uncached`: every stage computes the stencil weights again (SolverSettings::reuseStencilWeights off).
 #include "core/TwoPhaseSolver.hpp"
 #include "support/Fixtures.hpp"
 
@@ -56,18 +57,19 @@ double cpuSeconds()
 
 int main(int argc, char** argv)
 {
-	bool dry = false, explicitScheme = false, corrected = false, linear = false, valid = argc >= 4;
+	bool dry = false, explicitScheme = false, corrected = false, linear = false, uncached = false, valid = argc >= 4;
 	for (int a = 4; a < argc; ++a) {
 		const std::string option = argv[a];
 		if (option == "dry") dry = true;
 		else if (option == "explicit") explicitScheme = true;
 		else if (option == "corrected") corrected = true;
 		else if (option == "linear") linear = true;
+		else if (option == "uncached") uncached = true;
 		else valid = false;
 	}
 	const bool column = valid && std::string(argv[1]) == "column";
 	if (!valid || (!column && std::atoi(argv[1]) < 1)) {
-		std::fprintf(stderr, "usage: %s CELLS_PER_SIDE|column STEPS REPEATS [dry] [explicit] [corrected] [linear]\n", argv[0]);
+		std::fprintf(stderr, "usage: %s CELLS_PER_SIDE|column STEPS REPEATS [dry] [explicit] [corrected] [linear] [uncached]\n", argv[0]);
 		return 2;
 	}
 	const int    steps = std::atoi(argv[2]), repeats = std::atoi(argv[3]);
@@ -102,6 +104,7 @@ int main(int argc, char** argv)
 	SolverSettings s;
 	s.gravity = column ? Vec3::Zero() : Vec3(0, 0, -g);
 	if (linear) s.shapeFunction = ShapeFunction::Linear;
+	s.reuseStencilWeights = !uncached;
 	if (corrected) s.pressureCorrections = 2;
 	if (explicitScheme) {
 		s.scheme              = TimeScheme::Explicit;
@@ -146,6 +149,7 @@ int main(int argc, char** argv)
 	if (explicitScheme) label += "explicit ";
 	if (corrected) label += "2 corrections ";
 	if (linear) label += "linear ";
+	if (uncached) label += "uncached ";
 	auto         after   = solver.stageSeconds();
 	double       total   = 0;
 	for (int i = 0; i < static_cast<int>(Stage::Count); ++i) total += after[i] - before[i];

@@ -22,7 +22,7 @@ namespace stages {
 #pragma omp parallel for schedule(static) reduction(max : invalid) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
-			weightsAt<Kernel>(grid, points.position[p], points.halfLength[p], w);
+			weightsAt<Kernel>(grid, points, p, w);
 			Vec3 vNew = Vec3::Zero(), vOld = Vec3::Zero(), gained = Vec3::Zero();
 			Real kept = retention ? 0 : 1;
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
@@ -61,7 +61,7 @@ namespace stages {
 	{
 		scatter(lost, buffers, points.size(), [&](std::size_t p, Vec3* nodes) {
 			Weights1D w[3];
-			weightsAt<Kernel>(grid, points.position[p], points.halfLength[p], w);
+			weightsAt<Kernel>(grid, points, p, w);
 			Vec3 vOld = Vec3::Zero();
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) { vOld += N * gridVelocity[I]; });
 			const Real alpha      = picPoints && (*picPoints)[p] ? 0 : flipBlend; // PIC points keep no unresolved part to hand over
@@ -88,7 +88,7 @@ namespace stages {
 #pragma omp parallel for schedule(static) reduction(min : first) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
-			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			weightsAt<Kernel>(grid, P, p, w);
 			for (int d = 0; d < 3; ++d)
 				if (!std::isfinite(P.position[p][d]) || w[d].first < 0 || w[d].first + Kernel::stencil > grid.nodes[d]) first = std::min(first, static_cast<long>(p));
 		}

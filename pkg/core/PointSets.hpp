@@ -2,7 +2,10 @@
 // stages stream through memory and OpenMP splits them by index (doc/theory.md §4).
 #pragma once
 
+#include "ShapeFunctions.hpp"
 #include "Types.hpp"
+
+#include <array>
 
 #include <string>
 #include <vector>
@@ -26,6 +29,11 @@ struct MaterialPointSet {
 	std::vector<Real> mass;       // m_p [kg], constant over a run
 	std::vector<Real> volume;     // V_p [m³], current mixture volume represented by the point
 	std::vector<Vec3> halfLength; // l_p [m], GIMP half-size of the point's domain per axis
+	// Solver scratch, not point data: the 1D stencil weights of every point at its current position
+	// (theory.md eq. 3.2), computed once for the stages of a step that share the positions and
+	// empty otherwise (TwoPhaseSolver::cacheStencilWeights); `stencilWeightsSize` is the kernel's stencil.
+	std::vector<std::array<Weights1D, 3>> stencilWeights;
+	int                                   stencilWeightsSize = 0;
 
 	std::size_t size() const { return position.size(); }
 	// Check that every field has size() entries and holds finite, admissible values; throws

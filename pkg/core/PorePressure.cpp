@@ -102,7 +102,7 @@ namespace stages {
 		nodes.assign(grid.nodeCount(), zeroOf(PressureNode {}));
 		scatter(nodes, workspace.pressure, count, [&](std::size_t p, PressureNode* target) {
 			Weights1D w[3];
-			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			weightsAt<Kernel>(grid, P, p, w);
 			const Real V = P.volume[p], pV = V * P.porePressure[p];
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 				target[I].pressureVolume += N * pV;
@@ -120,7 +120,7 @@ namespace stages {
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
-			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			weightsAt<Kernel>(grid, P, p, w);
 			int node[3][Kernel::stencil];
 			stencilNodes(grid, w, node);
 			bool inside = true;
@@ -202,7 +202,7 @@ namespace stages {
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
-			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			weightsAt<Kernel>(grid, P, p, w);
 			Real divS = 0, divW = 0;
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) {
 				divS += solidVelocity[I].dot(dN);

@@ -36,7 +36,7 @@ namespace stages {
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 			for (std::size_t p = 0; p < count; ++p) {
 				Weights1D w[3];
-				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				weightsAt<Kernel>(grid, P, p, w);
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3&) {
 #pragma omp atomic write
 					row[I] = 0;
@@ -142,7 +142,7 @@ namespace stages {
 			const WaterPointSet& P     = *sets[s];
 			scatter(system.rows, system.rowBuffers, P.size(), [&](std::size_t p, Real* rows) {
 				Weights1D w[3];
-				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				weightsAt<Kernel>(grid, P, p, w);
 				int node[3][S];
 				stencilNodes(grid, w, node);
 				// the porosity and mobility at the water point (eqs. 4.5, 8.5), the divergence of the
@@ -202,7 +202,7 @@ namespace stages {
 			const SolidPointSet& P = *set.points;
 			scatter(system.rows, system.rowBuffers, P.size(), [&](std::size_t p, Real* rows) {
 				Weights1D w[3];
-				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				weightsAt<Kernel>(grid, P, p, w);
 				Real n = 0, divS = 0;
 				bool reaches = false;
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
@@ -425,7 +425,7 @@ namespace stages {
 			WaterPointSet&           P     = *sets[s];
 			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
 				Weights1D w[3];
-				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				weightsAt<Kernel>(grid, P, p, w);
 				Real q = 0, n = 0;
 				Vec3 gradq = Vec3::Zero();
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
@@ -453,7 +453,7 @@ namespace stages {
 			const SolidPointSet& P = *set.points;
 			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
 				Weights1D w[3];
-				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				weightsAt<Kernel>(grid, P, p, w);
 				Real q = 0, n = 0;
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 					q += N * pressure[I];
@@ -617,7 +617,7 @@ namespace stages {
 				const WaterPointSet& P = *set;
 				scatter(balance, balanceBuffers, P.size(), [&](std::size_t p, Real* rows) {
 					Weights1D w[3];
-					weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+					weightsAt<Kernel>(grid, P, p, w);
 					Real nn = 0, div = 0, qp = 0;
 					Vec3 rel = Vec3::Zero();
 					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
@@ -637,7 +637,7 @@ namespace stages {
 				const SolidPointSet& P = *set.points;
 				scatter(balance, balanceBuffers, P.size(), [&](std::size_t p, Real* rows) {
 					Weights1D w[3];
-					weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+					weightsAt<Kernel>(grid, P, p, w);
 					Real nn = 0, div = 0;
 					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 						nn += N * fields.porosity[I];

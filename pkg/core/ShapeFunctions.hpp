@@ -27,6 +27,9 @@ struct Weights1D {
 // Standard linear hat function: S = 1 − |ξ| for |ξ| < 1 (theory.md eq. 3.1 with l_p = 0).
 struct LinearKernel {
 	static constexpr int stencil = 2;
+	// the weights cost a floor and two subtractions: cheaper to compute in every stage than to read
+	// from a per-point cache (doc/benchmarks.md, issue 18)
+	static constexpr bool cachedWeights = false;
 	// u = (x_p − x_0)/h in grid units; `halfLength` ignored
 	static inline void evaluate(Real u, Real /*halfLength*/, Real invH, Weights1D& w)
 	{
@@ -44,6 +47,9 @@ struct LinearKernel {
 //   1 − a ≤ r < 1 + a: S = (1 + a − r)²/(4a)       dS/dx = −sgn(ξ)(1 + a − r)/(2 a h)
 struct GimpKernel {
 	static constexpr int stencil = 3;
+	// three branches per node and axis that a moving point mispredicts: computed once per point and
+	// position set, then read by every stage (TwoPhaseSolver::cacheStencilWeights)
+	static constexpr bool cachedWeights = true;
 	// u = (x_p − x_0)/h; `halfLength` = l_p/h
 	static inline void evaluate(Real u, Real a, Real invH, Weights1D& w)
 	{

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "Grid.hpp"
+#include "PointSets.hpp"
 #include "ShapeFunctions.hpp"
 
 #include <omp.h>
@@ -18,6 +19,19 @@ namespace mpm::detail {
 	{
 		const Real invH = 1 / g.cellSize;
 		for (int d = 0; d < 3; ++d) Kernel::evaluate((x[d] - g.origin[d]) * invH, std::min<Real>(halfLength[d] * invH, 0.5), invH, w[d]);
+	}
+
+	// The weights of point p of a set: from the set's cache when the solver filled it for this kernel
+	// (the same numbers as above, computed once per step and position set), else computed here.
+	template <class Kernel> inline void weightsAt(const GridGeometry& g, const MaterialPointSet& P, std::size_t p, Weights1D (&w)[3])
+	{
+		if constexpr (Kernel::cachedWeights)
+			if (P.stencilWeightsSize == Kernel::stencil && P.stencilWeights.size() == P.size()) {
+				const std::array<Weights1D, 3>& cached = P.stencilWeights[p];
+				w[0] = cached[0], w[1] = cached[1], w[2] = cached[2];
+				return;
+			}
+		weightsAt<Kernel>(g, P.position[p], P.halfLength[p], w);
 	}
 
 	// Node indices of the stencil per axis, wrapped along periodic axes (theory.md §2.7):

@@ -51,7 +51,7 @@ namespace stages {
 			const Vec3 bodyForce = water && submerged ? Vec3((1 - water->density / set.soil.density) * gravity) : gravity;
 			scatter(fields.solid, workspace.solid, P.size(), [&](std::size_t p, SolidNode* nodes) {
 				Weights1D w[3];
-				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				weightsAt<Kernel>(grid, P, p, w);
 				const Real   m = P.mass[p], V = P.volume[p], n = P.porosity[p];
 				const Mat3   sigma   = voigtToMatrix(P.effectiveStress[p]);
 				const Vec3   weight  = m * bodyForce + P.externalForce[p];
@@ -107,7 +107,7 @@ namespace stages {
 			WaterPointSet& P = *set;
 			scatter(fields.water, workspace.water, P.size(), [&](std::size_t p, WaterNode* nodes) {
 				Weights1D w[3];
-				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				weightsAt<Kernel>(grid, P, p, w);
 				// eq. 4.5: porosity and its gradient at the water point from the nodal field
 				Real n = 0;
 				Vec3 gradN = Vec3::Zero();
@@ -172,7 +172,7 @@ namespace stages {
 			const MaterialPointSet& P = *set;
 			scatter(sums, workspace.momentum, P.size(), [&](std::size_t p, MomentumNode* nodes) {
 				Weights1D w[3];
-				weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+				weightsAt<Kernel>(grid, P, p, w);
 				const Real m  = P.mass[p];
 				const Vec3 mv = m * P.velocity[p];
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
@@ -201,7 +201,7 @@ namespace stages {
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
-			weightsAt<Kernel>(grid, P.position[p], P.halfLength[p], w);
+			weightsAt<Kernel>(grid, P, p, w);
 			Mat3 L = Mat3::Zero();
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) { L.noalias() += gridVelocity[I] * dN.transpose(); });
 			gradients[p] = L;

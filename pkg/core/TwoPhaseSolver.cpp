@@ -1,6 +1,7 @@
 #include "TwoPhaseSolver.hpp"
 
 #include "Errors.hpp"
+#include "Stencil.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -78,6 +79,7 @@ const char* stageName(Stage s)
 {
 	switch (s) {
 		case Stage::ResetGrid: return "resetGrid";
+		case Stage::StencilWeights: return "stencilWeights";
 		case Stage::MapSolidToGrid: return "mapSolidToGrid";
 		case Stage::MapWaterToGrid: return "mapWaterToGrid";
 		case Stage::IntegrateNodalMomentum: return "integrateNodalMomentum";
@@ -335,7 +337,12 @@ void TwoPhaseSolver::step(Real dt)
 template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 {
 	const bool wet = !waters_.empty(), semiImplicit = wet && settings_.scheme == TimeScheme::SemiImplicit;
+	struct ClearWeightsOnExit { // also when a stage throws: no weights outlive the step
+		TwoPhaseSolver& solver;
+		~ClearWeightsOnExit() { solver.clearStencilWeights(); }
+	} clearWeights { *this };
 	resetGridStage(wet);                          // Step 0
+	cacheStencilWeights<Kernel>();                // §4.1: the weights at x^n, for Steps 1–7
 	mapPointsToGrid<Kernel>(wet);                 // Steps 1–5, eqs. 4.1–4.7
 	integrateMomentum(dt, wet, semiImplicit);     // Step 6, eqs. 4.8–4.10 (semi-implicit: predictor S1)
 	if (semiImplicit) projectPressure<Kernel>(dt); // S2–S3, eqs. 8.7–8.8
@@ -343,11 +350,40 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	const bool projectedRates = semiImplicit && settings_.shapeFunction != ShapeFunction::Linear;
 	if (projectedRates) skeletonRates<Kernel>();  // S4a, eq. 8.9: from v^{n+1} at x^n
 	movePoints<Kernel>(dt);                       // Step 7, eq. 4.11; water in and out, eqs. 2.4–2.5
+	cacheStencilWeights<Kernel>();                // §4.1: the weights at x^{n+1}, for Steps 8–10
 	remap<Kernel>(wet, !projectedRates);          // Step 8, eq. 4.12
 	if (!projectedRates) skeletonRates<Kernel>(); // eq. 4.13, from the re-mapped v̂ at x^{n+1}
 	updateSkeleton(dt);                           // Step 9, eqs. 4.13–4.15, §7
 	updateWater<Kernel>(dt, semiImplicit);        // Step 10, eqs. 4.16–4.17c, 2.1, 2.3 (semi-implicit: S4, the volume only)
 	updateDomains();                              // Step 11, eq. 3.3
+}
+
+template <class Kernel> void TwoPhaseSolver::cacheStencilWeights()
+{
+	if constexpr (!Kernel::cachedWeights) return;
+	if (!settings_.reuseStencilWeights) return;
+	StageTimer t(stageSeconds_, Stage::StencilWeights);
+	auto       fill = [&](MaterialPointSet& P) {
+		const std::size_t count = P.size();
+		P.stencilWeights.resize(count);
+		P.stencilWeightsSize = 0; // not read while it is being filled
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			Weights1D w[3];
+			detail::weightsAt<Kernel>(grid_, P.position[p], P.halfLength[p], w);
+			P.stencilWeights[p] = { w[0], w[1], w[2] };
+		}
+		P.stencilWeightsSize = Kernel::stencil;
+	};
+	for (SolidSet& s : solids_) fill(*s.points);
+	for (WaterPointSet* w : waters_) fill(*w);
+}
+
+void TwoPhaseSolver::clearStencilWeights()
+{
+	// the storage is kept for the next step (its size is the cache's validity: cleared, it is empty)
+	for (SolidSet& s : solids_) s.points->stencilWeights.clear();
+	for (WaterPointSet* w : waters_) w->stencilWeights.clear();
 }
 
 std::vector<ProjectionForms> TwoPhaseSolver::projectionForms(Real dt, const std::function<std::vector<std::vector<Real>>(const std::vector<Vec3>&)>& fields)
@@ -514,6 +550,11 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 				waterDragLoss_[I]  = waterRetention_[I] < 1 ? Vec3(inertiaScale_ * toWater / fields_.water[I].mass) : Vec3::Zero();
 			}
 		}
+		// the kinematics read each point's weights at x^n before moving it; then they are stale
+		struct ClearWeightsAfterMove {
+			TwoPhaseSolver& solver;
+			~ClearWeightsAfterMove() { solver.clearStencilWeights(); }
+		} clearWeights { *this };
 		for (std::size_t s = 0; s < solids_.size(); ++s)
 			check(stages::updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, exchange ? &solidRetention_ : nullptr,
 			                                            exchange ? &solidDragLoss_ : nullptr, *solids_[s].points, dt, settings_.flipBlend),
