@@ -342,7 +342,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 		~ClearWeightsOnExit() { solver.clearStencilWeights(); }
 	} clearWeights { *this };
 	resetGridStage(wet);                          // Step 0
-	cacheStencilWeights<Kernel>();                // §4.1: the weights at x^n, for Steps 1–7
+	cacheStencilWeights<Kernel>();                // §4 stencil weights at x^n, for Steps 1–7
 	mapPointsToGrid<Kernel>(wet);                 // Steps 1–5, eqs. 4.1–4.7
 	integrateMomentum(dt, wet, semiImplicit);     // Step 6, eqs. 4.8–4.10 (semi-implicit: predictor S1)
 	if (semiImplicit) projectPressure<Kernel>(dt); // S2–S3, eqs. 8.7–8.8
@@ -350,7 +350,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	const bool projectedRates = semiImplicit && settings_.shapeFunction != ShapeFunction::Linear;
 	if (projectedRates) skeletonRates<Kernel>();  // S4a, eq. 8.9: from v^{n+1} at x^n
 	movePoints<Kernel>(dt);                       // Step 7, eq. 4.11; water in and out, eqs. 2.4–2.5
-	cacheStencilWeights<Kernel>();                // §4.1: the weights at x^{n+1}, for Steps 8–10
+	cacheStencilWeights<Kernel>();                // §4 stencil weights at x^{n+1}, for Steps 8–10
 	remap<Kernel>(wet, !projectedRates);          // Step 8, eq. 4.12
 	if (!projectedRates) skeletonRates<Kernel>(); // eq. 4.13, from the re-mapped v̂ at x^{n+1}
 	updateSkeleton(dt);                           // Step 9, eqs. 4.13–4.15, §7

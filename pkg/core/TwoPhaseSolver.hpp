@@ -30,7 +30,7 @@ struct SolverSettings {
 	bool          freeSurfaceHoldsSuction    = false; // eq. 2.3b (explicit scheme only): the surface keeps suction (p < 0) and releases only p > 0
 	long          maxSubSteps                = 100000; // N_max [-] ≥ 1: advance(dt) refuses a dt that needs more sub-steps than this (a mistyped step, not a run)
 	Real          inertiaScale               = 1;    // α [-] ≥ 1: both phases' inertia × α, weights, drag and stresses not (eq. 4.8b); the step grows as √α
-	bool          reuseStencilWeights        = true;  // GIMP kernels: each point's weights computed once per position set and read by every stage of the step (§4.1); results identical bit for bit, false only to measure the gain
+	bool          reuseStencilWeights        = true;  // GIMP kernels: each point's weights computed once per position set and read by every stage of the step (theory.md §4, stencil weights); results identical bit for bit, false only to measure the gain
 	Real          inertiaScaleRelease        = 0.1;  // ε [-] > 0: α returns to 1 for good once the skeleton's net inertial force exceeds ε × its weight (eq. 4.8c); inf: never
 	void          validate() const;
 };

@@ -1,4 +1,4 @@
-// The per-point stencil-weight cache (theory.md §4.1, issue 18): the weights a stage reads from the
+// The per-point stencil-weight cache (theory.md §4, stencil weights; issue 18): the weights a stage reads from the
 // cache are the numbers it would compute itself, so a run with the cache must equal the run without
 // it bit for bit — for every kernel, both schemes, and 1 and 2 threads — on a scene where the points
 // sit off the lattice and move across cell boundaries (so the cache is refilled at new positions).
