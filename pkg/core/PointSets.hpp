@@ -6,7 +6,6 @@
 #include "Types.hpp"
 
 #include <array>
-
 #include <string>
 #include <vector>
 
@@ -31,9 +30,8 @@ struct MaterialPointSet {
 	std::vector<Vec3> halfLength; // l_p [m], GIMP half-size of the point's domain per axis
 	// Solver scratch, not point data: the 1D stencil weights of every point at its current position
 	// (theory.md eq. 3.2), computed once for the stages of a step that share the positions and
-	// empty otherwise (TwoPhaseSolver::cacheStencilWeights); `stencilWeightsSize` is the kernel's stencil.
+	// empty otherwise (TwoPhaseSolver::cacheStencilWeights): valid exactly when it has size() entries.
 	std::vector<std::array<Weights1D, 3>> stencilWeights;
-	int                                   stencilWeightsSize = 0;
 
 	std::size_t size() const { return position.size(); }
 	// Check that every field has size() entries and holds finite, admissible values; throws

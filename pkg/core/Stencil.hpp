@@ -21,12 +21,12 @@ namespace mpm::detail {
 		for (int d = 0; d < 3; ++d) Kernel::evaluate((x[d] - g.origin[d]) * invH, std::min<Real>(halfLength[d] * invH, 0.5), invH, w[d]);
 	}
 
-	// The weights of point p of a set: from the set's cache when the solver filled it for this kernel
-	// (the same numbers as above, computed once per step and position set), else computed here.
+	// The weights of point p of a set: from the set's cache when the solver filled it (the same numbers
+	// as above, computed once per position set; only kernels with cachedWeights fill it), else computed here.
 	template <class Kernel> inline void weightsAt(const GridGeometry& g, const MaterialPointSet& P, std::size_t p, Weights1D (&w)[3])
 	{
 		if constexpr (Kernel::cachedWeights)
-			if (P.stencilWeightsSize == Kernel::stencil && P.stencilWeights.size() == P.size()) {
+			if (P.stencilWeights.size() == P.size()) {
 				const std::array<Weights1D, 3>& cached = P.stencilWeights[p];
 				w[0] = cached[0], w[1] = cached[1], w[2] = cached[2];
 				return;

@@ -337,10 +337,7 @@ void TwoPhaseSolver::step(Real dt)
 template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 {
 	const bool wet = !waters_.empty(), semiImplicit = wet && settings_.scheme == TimeScheme::SemiImplicit;
-	struct ClearWeightsOnExit { // also when a stage throws: no weights outlive the step
-		TwoPhaseSolver& solver;
-		~ClearWeightsOnExit() { solver.clearStencilWeights(); }
-	} clearWeights { *this };
+	const StencilWeightsScope weightsScope { *this }; // also when a stage throws: no weights outlive the step
 	resetGridStage(wet);                          // Step 0
 	cacheStencilWeights<Kernel>();                // §4 stencil weights at x^n, for Steps 1–7
 	mapPointsToGrid<Kernel>(wet);                 // Steps 1–5, eqs. 4.1–4.7
@@ -366,14 +363,12 @@ template <class Kernel> void TwoPhaseSolver::cacheStencilWeights()
 	auto       fill = [&](MaterialPointSet& P) {
 		const std::size_t count = P.size();
 		P.stencilWeights.resize(count);
-		P.stencilWeightsSize = 0; // not read while it is being filled
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			detail::weightsAt<Kernel>(grid_, P.position[p], P.halfLength[p], w);
 			P.stencilWeights[p] = { w[0], w[1], w[2] };
 		}
-		P.stencilWeightsSize = Kernel::stencil;
 	};
 	for (SolidSet& s : solids_) fill(*s.points);
 	for (WaterPointSet* w : waters_) fill(*w);
@@ -551,10 +546,7 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 			}
 		}
 		// the kinematics read each point's weights at x^n before moving it; then they are stale
-		struct ClearWeightsAfterMove {
-			TwoPhaseSolver& solver;
-			~ClearWeightsAfterMove() { solver.clearStencilWeights(); }
-		} clearWeights { *this };
+		const StencilWeightsScope weightsScope { *this };
 		for (std::size_t s = 0; s < solids_.size(); ++s)
 			check(stages::updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, exchange ? &solidRetention_ : nullptr,
 			                                            exchange ? &solidDragLoss_ : nullptr, *solids_[s].points, dt, settings_.flipBlend),

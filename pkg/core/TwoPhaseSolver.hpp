@@ -146,9 +146,14 @@ private:
 	template <class Kernel> std::vector<ProjectionForms> projectionFormsWith(Real dt, const std::function<std::vector<std::vector<Real>>(const std::vector<Vec3>&)>& fields);
 	template <class Kernel> void stepWith(Real dt);
 	// The stencil weights of every point at its current position, computed once and read by every
-	// stage until the points move (theory.md §4.1); cleared before they move and when a step ends.
+	// stage until the points move (theory.md §4, stencil weights); cleared before they move and when
+	// a step ends, by a scope that clears them on leaving (also by an exception).
 	template <class Kernel> void cacheStencilWeights();
 	void                         clearStencilWeights();
+	struct StencilWeightsScope {
+		TwoPhaseSolver& solver;
+		~StencilWeightsScope() { solver.clearStencilWeights(); }
+	};
 	// the stages of one step, in order (theory.md §4 and §8.3); each times itself
 	void                         resetGridStage(bool wet);
 	template <class Kernel> void mapPointsToGrid(bool wet);
