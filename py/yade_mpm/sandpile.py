@@ -81,6 +81,14 @@ class SandPileScene:
         down = self.pile_height - (x - self.crest_length) * math.tan(self.slope_angle)
         return np.where(x <= self.crest_length, self.pile_height, np.clip(down, 0, None))
 
+    def probe_points(self, flume_width=None):
+        """Pore-pressure probes {name: (x, y, z)} [m] at mid-width (of `flume_width`, default the
+        flume's): upstream, at the crest's edge, mid-slope and near the toe, 2 cm (the toe's 1 cm)
+        above the base, where the seepage field of the rising head is read in every model."""
+        y = 0.5 * (self.flume_width if flume_width is None else flume_width)
+        return {"upstream x=0.05": (0.05, y, 0.02), "crest edge x=%.2f" % self.crest_length: (self.crest_length, y, 0.02),
+                "mid slope x=0.20": (0.20, y, 0.02), "near toe x=0.27": (0.27, y, 0.01)}
+
     def head(self, time):
         """Inflow water level [m] at time t [s]: held while settling, raised linearly, then held."""
         r = min(max((time - self.settle_time) / self.head_ramp_time, 0.0), 1.0)

@@ -1,0 +1,261 @@
+"""The DEM + pore-fluid sand pile, in YADE itself: spheres coupled to YADE's pore-scale flow (PFV,
+``FlowEngine``) in a slice of the MPM pile's flume, under the same head history (issue 16; the facts
+behind the set-up are in doc/dem.md, "The sand pile").
+
+    scene = yade_mpm.sandpile.SUBMERGED_LIDDED            # geometry and heads of the MPM pile
+    pile = yade_mpm.dem_pile.build(scene)                 # deposit, carve, freeze a rough base, settle
+    run = yade_mpm.dem_pile.raise_head(pile, scene.with_head_history(ramp_time=2.0))
+
+Every number of the geometry and the heads comes from the `SandPileScene` (no copies); what is the
+DEM's own is the grain size, the slice width and the contact law. The pile is fully saturated and
+submerged: PFV solves the *excess* pore pressure, so the grains feel the buoyant gravity
+g(1 − ρw/ρs) with their true mass for inertia, the inflow wall (x = 0) carries the excess
+ρw g (head − still_water_level), the outflow wall at the flume's end 0, and the base, the lid on the
+crest and the front and rear walls are impermeable. The water over the slope is the void PFV meshes
+between the slope and the outflow wall: its pores are large, so the slope is a drained face.
+
+The walls are YADE's ``aabbWalls`` in the order xMin, xMax, yMin, yMax, zMin, zMax (FlowEngine's
+boundary order); the axis z is vertical and x runs down the flume, as in the MPM example. The grains
+are spheres with rolling resistance (``CohFrictMat`` with ``etaRoll``, non-cohesive): spheres that
+roll freely are weaker than a 30° slope of real sand (doc/dem.md, the triaxial tests).
+"""
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import yade.wrapper as w
+from yade import O, Vector3
+
+from .dem import XMIN, XMAX, YMIN, YMAX, ZMIN, ZMAX, _require  # noqa: F401  (the wall order)
+
+
+@dataclass
+class PileSample:
+    """A carved, settled sphere pile in a slice of the flume, ready for the head rise."""
+    wall_ids: list           # body ids of the walls, xMin..zMax (xMin: inflow, xMax: outflow, zMax: the lid)
+    grain_ids: np.ndarray    # ids of the free grains
+    base_ids: np.ndarray     # ids of the frozen grains of the rough base
+    start_positions: np.ndarray  # free grains' centres when the head rise starts [m], rows of grain_ids
+    slice_width: float       # [m] along y
+    grain_radius: float      # mean radius [m]
+    buoyant_gravity: float   # |g|(1 − ρw/ρs) [m s⁻²]
+    crest_height: float      # where the lid came to rest on the crest [m]
+    lid_pressure: float      # the lid's weight over the crest while it settled [Pa]
+    build_steps: int         # DEM steps of the deposition and the settling [-]
+    build_wall_time: float   # [s]
+
+    def positions(self):
+        """Centres of the free grains now [m], rows of grain_ids."""
+        return np.array([O.bodies[int(i)].state.pos for i in self.grain_ids])
+
+    def velocities(self):
+        return np.array([O.bodies[int(i)].state.vel for i in self.grain_ids])
+
+    def masses(self):
+        return np.array([O.bodies[int(i)].state.mass for i in self.grain_ids])
+
+
+def _grain_material(young, contact_poisson, friction_angle, rolling_resistance, density, label):
+    # non-cohesive CohFrictMat: Coulomb friction plus a rolling moment capped at etaRoll × r × Fn
+    return w.CohFrictMat(young=young, poisson=contact_poisson, frictionAngle=friction_angle, density=density, isCohesive=False,
+                         momentRotationLaw=rolling_resistance > 0, etaRoll=rolling_resistance, alphaKr=2.0, label=label)
+
+
+def _engines(gravity, damping):
+    return [
+        w.ForceResetter(),
+        w.InsertionSortCollider([w.Bo1_Sphere_Aabb(), w.Bo1_Box_Aabb()]),
+        w.InteractionLoop([w.Ig2_Sphere_Sphere_ScGeom6D(), w.Ig2_Box_Sphere_ScGeom6D()], [w.Ip2_CohFrictMat_CohFrictMat_CohFrictPhys()],
+                          [w.Law2_ScGeom6D_CohFrictPhys_CohesionMoment(useIncrementalForm=True, always_use_moment_law=False)]),
+        w.FlowEngine(dead=True, label="flow"),
+        w.NewtonIntegrator(damping=damping, gravity=gravity, label="newton"),
+    ]
+
+
+def _settle(max_steps, unbalanced=0.01, speed=1e-4, grain_ids=None):
+    """Step until the unbalanced force is below `unbalanced` and every free grain is slower than
+    `speed` [m s⁻¹]. Returns the steps taken."""
+    from yade import utils
+    steps = 0
+    while steps < max_steps:
+        O.run(500, True)
+        steps += 500
+        fastest = max((O.bodies[int(i)].state.vel.norm() for i in grain_ids), default=0.0) if grain_ids is not None else 0.0
+        if utils.unbalancedForce() < unbalanced and fastest < speed:
+            return steps
+    raise RuntimeError("the pile did not come to rest within %d steps (unbalanced force %.3g)" % (max_steps, utils.unbalancedForce()))
+
+
+def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.03, friction_angle=math.radians(30), rolling_resistance=0.3,
+          young=2e6, contact_poisson=0.5, wall_friction_angle=0.0, lid_friction_angle=None, lid_pressure=None, seed=1, max_steps=200000):
+    """Reset the scene and build the pile of `scene` (a yade_mpm.sandpile.SandPileScene with still
+    water: PFV models a fully saturated pile) in a slice `slice_width` [m] wide: spheres of mean
+    `grain_radius` [m] (± `radius_spread`, relative) rained into the box between the inflow wall
+    and a gate at the toe, under full gravity with 1° contact friction (a dense packing); carved to
+    the scene's surface (a grain stays if its centre lies below the slope, or its top below the
+    crest); the grains within 1.7 radii of the base frozen (the rough base the MPM's frictional base
+    stands for); the gate moved to the flume's end and the lid lowered onto the crest; then the
+    contact `friction_angle` and `rolling_resistance` (etaRoll [-], the rolling moment's cap in units
+    of r Fn) switched on and the pile settled under buoyant gravity. `young` [Pa] and
+    `contact_poisson` [-] are the contact stiffness parameters; `wall_friction_angle` [rad] that of
+    the lid and the front and rear walls; `gravity` the scene's gravity vector [m s⁻²] (z down).
+    Returns a PileSample."""
+    from yade import pack, utils
+    scene.validate()
+    _require("scene.still_water_level", scene.still_water_level, scene.still_water_level is not None,
+             "a level at or above the pile (PFV models a fully saturated, submerged pile)")
+    _require("grain_radius", grain_radius, 0 < grain_radius <= scene.pile_height / 8, "(0, pile_height/8] m (at least four grains over the height)")
+    _require("radius_spread", radius_spread, 0 <= radius_spread < 1, "[0, 1)")
+    _require("slice_width", slice_width, slice_width >= 4 * grain_radius, "[4 grain_radius, inf) m (two grains across)")
+    _require("friction_angle", friction_angle, 0 < friction_angle < math.pi / 2, "(0, π/2) rad")
+    _require("rolling_resistance", rolling_resistance, rolling_resistance >= 0, "[0, inf)")
+    _require("wall_friction_angle", wall_friction_angle, 0 <= wall_friction_angle < math.pi / 2, "[0, π/2) rad")
+    clock = time.time()
+    O.reset()
+    g = float(np.linalg.norm(gravity))
+    grains_mat = O.materials.append(_grain_material(young, contact_poisson, math.radians(1), 0.0, scene.grain_density, "grains"))
+    walls_mat = O.materials.append(_grain_material(young, contact_poisson, wall_friction_angle, 0.0, 0.0, "walls"))
+    lid_friction_angle = friction_angle if lid_friction_angle is None else lid_friction_angle
+    lid_mat = O.materials.append(_grain_material(young, contact_poisson, lid_friction_angle, 0.0, 0.0, "lid"))
+    height, toe = scene.pile_height, scene.toe_x()
+    # the flume's walls (PFV's boundaries, ids 0–5), the lid still high; a gate at the toe while the grains are rained in
+    top = 3 * height
+    wall_ids = list(O.bodies.append(utils.aabbWalls([Vector3(0, 0, 0), Vector3(scene.flume_length, slice_width, top)], thickness=0,
+                                                    material=walls_mat)))
+    gate = O.bodies.append(utils.box(Vector3(toe, 0.5 * slice_width, 0.5 * top), Vector3(0, 0.5 * slice_width, 0.5 * top), fixed=True,
+                                     material=walls_mat))
+    solid_fraction = 0.62
+    grain_volume = 4 / 3 * math.pi * grain_radius ** 3 * (1 + radius_spread ** 2)
+    count = int(1.2 * height * toe * slice_width * solid_fraction / grain_volume)
+    cloud = pack.SpherePack()
+    cloud.makeCloud(Vector3(0, 0, 0), Vector3(toe, slice_width, top), grain_radius, radius_spread, count, False, 0.95, seed=seed)
+    O.bodies.append([utils.sphere(c, r, material=grains_mat) for c, r in cloud])
+    O.engines = _engines(Vector3(0, 0, -g), damping=0.4)
+    O.dt = 0.5 * utils.PWaveTimeStep()
+    grains = [b.id for b in O.bodies if isinstance(b.shape, w.Sphere)]
+    deposition_steps = _settle(max_steps, grain_ids=grains, unbalanced=0.1, speed=2e-2)
+    # carve to the scene's surface
+    for i in grains:
+        b = O.bodies[i]
+        x, z, r = b.state.pos[0], b.state.pos[2], b.shape.radius
+        if z > float(scene.surface_height(x)) or z + r > height:
+            O.bodies.erase(i)
+    grains = [b.id for b in O.bodies if isinstance(b.shape, w.Sphere)]
+    base = [i for i in grains if O.bodies[i].state.pos[2] < 1.7 * grain_radius]
+    for i in base:
+        s = O.bodies[i].state
+        s.blockedDOFs, s.vel, s.angVel = "xyzXYZ", Vector3(0, 0, 0), Vector3(0, 0, 0)
+    free = [i for i in grains if i not in set(base)]
+    # the gate opens, the lid comes down onto the crest
+    O.bodies.erase(gate)
+    lid = O.bodies[wall_ids[ZMAX]]
+    lid.state.pos = Vector3(lid.state.pos[0], lid.state.pos[1], height)
+    lid.material = O.materials[lid_mat]
+    # the real contact law from here on: the contacts are made anew from the material (their normal
+    # forces come back from the overlaps at once; the shear and rolling springs start from zero)
+    O.materials[grains_mat].frictionAngle = friction_angle
+    O.materials[grains_mat].etaRoll = rolling_resistance
+    O.materials[grains_mat].momentRotationLaw = rolling_resistance > 0
+    O.interactions.clear()
+    buoyant = g * (1 - scene.water_density / scene.grain_density)
+    O.engines[-1].gravity = Vector3(0, 0, -buoyant)
+    O.engines[-1].damping = 0.2
+    # the lid rests on the crest with the weight of one grain radius of buoyant sand by default: a lid
+    # held at a fixed height leaves a gap over the settled crest, a channel the seepage sweeps the
+    # top grains along
+    lid_pressure = (scene.grain_density - scene.water_density) * (1 - scene.porosity) * g * grain_radius if lid_pressure is None else lid_pressure
+    lid.state.blockedDOFs = "xyXYZ"
+    lid.state.mass = lid_pressure * scene.crest_length * slice_width / buoyant
+    settling_steps = _settle(max_steps, grain_ids=free, speed=1e-4)
+    # then held where it rests: it holds heave (the excess pressure under it would lift a weight)
+    lid.state.blockedDOFs, lid.state.vel = "xyzXYZ", Vector3(0, 0, 0)
+    pile = PileSample(wall_ids=wall_ids, grain_ids=np.array(free), base_ids=np.array(base), start_positions=None, slice_width=slice_width,
+                      grain_radius=grain_radius, buoyant_gravity=buoyant, crest_height=lid.state.pos[2], lid_pressure=lid_pressure,
+                      build_steps=deposition_steps + settling_steps, build_wall_time=0.0)
+    pile.start_positions = pile.positions()
+    pile.build_wall_time = time.time() - clock
+    return pile
+
+
+def _region(pile, scene, which):
+    """Rows of pile.grain_ids in the toe region (within four radii of the toe along the base) or on
+    the lower slope face (within four radii of the downstream surface, below mid-height) at the start:
+    the same regions as the MPM example's, measured in grains instead of cells."""
+    x, z = pile.start_positions[:, 0], pile.start_positions[:, 2]
+    reach = 4 * pile.grain_radius
+    if which == "toe":
+        return np.flatnonzero((x > scene.toe_x() - 2 * reach) & (z < reach))
+    return np.flatnonzero((x > scene.crest_length) & (z < 0.5 * scene.pile_height) & (scene.surface_height(x) - z < reach))
+
+
+def excess_head_pressure(scene, gravity, t):
+    """Excess pore pressure on the inflow wall at time t [Pa]: ρw |g| (head(t) − still water level)."""
+    return scene.water_density * float(np.linalg.norm(gravity)) * (scene.head(t) - scene.still_water_level)
+
+
+def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, boundary_update_steps=10):
+    """The head rise on a built pile: PFV switched on (incompressible fluid of `viscosity` [Pa s],
+    default the scene's water), the inflow wall at the excess pressure of scene.head(t) above the
+    still water (updated every `boundary_update_steps` steps), the outflow wall at 0, the rest
+    impermeable; stepped to scene.duration() from t = 0 (the scene's settle, rise and hold: pass a
+    scene with a compressed history, e.g. dataclasses.replace(scene, head_ramp_time=2.0), see
+    doc/dem.md). Every `record_interval` [s] it records the head, the pore pressure at the scene's
+    probe points (mid-slice), the fluxes through the inflow and outflow walls [m³ s⁻¹], the free
+    grains' kinetic energy [J], the mean toe displacement along x and the mean displacement of the
+    lower slope face [m]. Returns a dict of lists with the onsets (yade_mpm.analysis: kinetic and
+    compliance) and the wall time."""
+    from . import analysis
+    _require("record_interval", record_interval, record_interval > 0, "(0, inf) s")
+    _require("boundary_update_steps", boundary_update_steps, int(boundary_update_steps) >= 1, "[1, inf)")
+    viscosity = scene.water_viscosity if viscosity is None else viscosity
+    _require("viscosity", viscosity, viscosity > 0, "(0, inf) Pa s")
+    flow = O.engines[[e.label for e in O.engines].index("flow")]
+    flow.dead = False
+    flow.viscosity = viscosity
+    flow.permeabilityFactor = 1
+    flow.useSolver = 3  # CHOLMOD
+    flow.defTolerance = 0.3
+    flow.meshUpdateInterval = 200
+    flow.boundaryUseMaxMin = [0] * 6
+    flow.bndCondIsPressure = [1 if f in (XMIN, XMAX) else 0 for f in range(6)]
+
+    def inflow_pressure():
+        return excess_head_pressure(scene, gravity, O.time - start)
+
+    start, clock = O.time, time.time()
+    flow.bndCondValue = [inflow_pressure() if f == XMIN else 0.0 for f in range(6)]
+    toe_rows, face_rows = _region(pile, scene, "toe"), _region(pile, scene, "face")
+    probes = scene.probe_points(pile.slice_width)
+    masses = pile.masses()
+    record = {name: [] for name in ("time", "head", "inflow_pressure", "inflow", "outflow", "kinetic_energy", "toe_displacement",
+                                    "face_displacement", "max_displacement")}
+    record["probes"] = {name: [] for name in probes}
+    steps_per_record = max(1, int(round(record_interval / O.dt)))
+    while O.time - start < scene.duration() - 0.5 * O.dt:
+        for step in range(steps_per_record):
+            O.step()  # synchronous: O.run(n, True) in short chunks waits on YADE's thread far longer than a step takes
+            if step % boundary_update_steps == 0:
+                flow.bndCondValue = [inflow_pressure() if f == XMIN else 0.0 for f in range(6)]
+                flow.updateBCs()
+        positions, velocities = pile.positions(), pile.velocities()
+        displacement = positions - pile.start_positions
+        record["time"].append(O.time - start)
+        record["head"].append(scene.head(O.time - start))
+        record["inflow_pressure"].append(inflow_pressure())
+        record["inflow"].append(-flow.getBoundaryFlux(pile.wall_ids[XMIN]))
+        record["outflow"].append(flow.getBoundaryFlux(pile.wall_ids[XMAX]))
+        record["kinetic_energy"].append(analysis.kinetic_energy(masses, velocities))
+        record["toe_displacement"].append(float(displacement[toe_rows, 0].mean()))
+        record["face_displacement"].append(float(np.linalg.norm(displacement[face_rows], axis=1).mean()))
+        record["max_displacement"].append(float(np.linalg.norm(displacement, axis=1).max()))
+        for name, location in probes.items():
+            record["probes"][name].append(flow.getPorePressure(Vector3(*location)))
+    flow.dead = True
+    # the MPM example's criterion (the kinetic one fires at the ramp's start: a pile at rest gains
+    # kinetic energy as its elastic response follows the rising head)
+    onset = analysis.compliance_onset(record["head"], record["face_displacement"])
+    record.update(onset_index=onset, onset_head=None if onset is None else record["head"][onset],
+                  onset_time=None if onset is None else record["time"][onset],
+                  steps=int(round((O.time - start) / O.dt)), wall_time=time.time() - clock, grains=len(pile.grain_ids), time_step=O.dt)
+    return record
