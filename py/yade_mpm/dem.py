@@ -58,20 +58,48 @@ def _require(name, value, valid, text):
         raise ValueError("%s = %r is outside the valid range %s" % (name, value, text))
 
 
-def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle, grain_density, seed):
+def contact_material(young, contact_poisson, friction_angle, rolling_resistance, density, label):
+    """The grains' (or a wall's) contact material: YADE's FrictMat (Coulomb friction) for
+    `rolling_resistance` None, else a non-cohesive CohFrictMat whose rolling moment is capped at
+    etaRoll × r × Fn (r the smaller radius; etaRoll = rolling_resistance ≥ 0), rolling stiffness
+    2 ks r² (alphaKr = 2); the twisting moment has the same cap and stiffness (YADE's default
+    etaTwist = −1 leaves it elastic without a cap)."""
+    if rolling_resistance is None:
+        return w.FrictMat(young=young, poisson=contact_poisson, frictionAngle=friction_angle, density=density, label=label)
+    return w.CohFrictMat(young=young, poisson=contact_poisson, frictionAngle=friction_angle, density=density, isCohesive=False,
+                         momentRotationLaw=rolling_resistance > 0, etaRoll=rolling_resistance, etaTwist=rolling_resistance, alphaKr=2.0,
+                         alphaKtw=2.0, label=label)
+
+
+def contact_loop(rolling_resistance):
+    """The InteractionLoop for contact_material(…, rolling_resistance, …): Cundall–Strack for None,
+    else the 6-DOF law with the rolling moment."""
+    if rolling_resistance is None:
+        return w.InteractionLoop([w.Ig2_Sphere_Sphere_ScGeom(), w.Ig2_Box_Sphere_ScGeom()], [w.Ip2_FrictMat_FrictMat_FrictPhys()],
+                                 [w.Law2_ScGeom_FrictPhys_CundallStrack()])
+    return w.InteractionLoop([w.Ig2_Sphere_Sphere_ScGeom6D(), w.Ig2_Box_Sphere_ScGeom6D()], [w.Ip2_CohFrictMat_CohFrictMat_CohFrictPhys()],
+                             # without always_use_moment_law a contact that was never cohesive gets no moment
+                             [w.Law2_ScGeom6D_CohFrictPhys_CohesionMoment(useIncrementalForm=True, always_use_moment_law=True)])
+
+
+def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle, grain_density, seed, rolling_resistance=None):
     """Reset the scene; spheres in a width³ box of smooth walls compacted isotropically to `stress`
-    by particle growth with 3° contact friction (a dense packing), then given `friction_angle`.
-    Returns the wall ids and the TriaxialStressController (still in O.engines)."""
+    by particle growth with 3° contact friction and no rolling resistance (a dense packing), then
+    given `friction_angle` and `rolling_resistance` (None: no rolling law, see contact_material). Returns the wall ids and the
+    TriaxialStressController (still in O.engines)."""
     _require("grains", grains, isinstance(grains, int) and grains >= 50, "[50, inf) (fewer grains cannot fill the box)")
     _require("width", width, width > 0, "(0, inf) m")
     _require("stress", stress, 0 < stress < young, "(0, young) Pa")
     _require("friction_angle", friction_angle, 0 < friction_angle < math.pi / 2, "(0, π/2) rad")
+    _require("rolling_resistance", rolling_resistance, rolling_resistance is None or rolling_resistance >= 0, "None or [0, inf)")
     from yade import pack, utils
     O.reset()
     _pfv_solved[0] = False
     lower, upper = Vector3(0, 0, 0), Vector3(width, width, width)
-    O.materials.append(w.FrictMat(young=young, poisson=contact_poisson, frictionAngle=math.radians(3), density=grain_density, label="grains"))
-    O.materials.append(w.FrictMat(young=young, poisson=contact_poisson, frictionAngle=0, density=0, label="walls"))
+    # compacted without rolling resistance: with it the packing would stay looser
+    compaction_rolling = None if rolling_resistance is None else 0.0
+    O.materials.append(contact_material(young, contact_poisson, math.radians(3), compaction_rolling, grain_density, "grains"))
+    O.materials.append(contact_material(young, contact_poisson, 0.0, compaction_rolling, 0.0, "walls"))
     wall_ids = list(O.bodies.append(utils.aabbWalls([lower, upper], thickness=0, material="walls")))
     cloud = pack.SpherePack()
     cloud.makeCloud(lower, upper, -1, 0.3333, grains, False, 0.95, seed=seed)
@@ -81,8 +109,7 @@ def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle
     O.engines = [
         w.ForceResetter(),
         w.InsertionSortCollider([w.Bo1_Sphere_Aabb(), w.Bo1_Box_Aabb()]),
-        w.InteractionLoop([w.Ig2_Sphere_Sphere_ScGeom(), w.Ig2_Box_Sphere_ScGeom()], [w.Ip2_FrictMat_FrictMat_FrictPhys()],
-                          [w.Law2_ScGeom_FrictPhys_CundallStrack()]),
+        contact_loop(rolling_resistance),
         w.FlowEngine(dead=True, label="flow"),
         w.GlobalStiffnessTimeStepper(active=True, timeStepUpdateInterval=100, timestepSafetyCoefficient=0.8),
         controller,
@@ -95,6 +122,11 @@ def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle
     else:
         raise RuntimeError("the compaction to %g Pa did not reach equilibrium in 200 000 steps" % stress)
     utils.setContactFriction(friction_angle)
+    if rolling_resistance:
+        # the contacts are made anew with the rolling cap (normal forces come back from the overlaps)
+        O.materials[0].etaRoll = O.materials[0].etaTwist = rolling_resistance
+        O.materials[0].momentRotationLaw = True
+        O.interactions.clear()
     return wall_ids, controller
 
 
@@ -251,7 +283,7 @@ def consolidate(sample, load, viscosity, times, depths=(0.3, 0.5, 0.7, 0.9), tim
 
 
 def drained_triaxial(grains=300, confinement=10e3, friction_angle=math.radians(30), strain_rate=0.02, final_strain=0.15, width=1.0,
-                     young=1e6, contact_poisson=0.5, grain_density=2600.0, seed=1):
+                     young=1e6, contact_poisson=0.5, grain_density=2600.0, seed=1, rolling_resistance=None):
     """A drained triaxial compression on the same kind of assembly: compacted isotropically to
     `confinement` [Pa], then the top wall moves at the axial `strain_rate` [s⁻¹] (slow enough for
     quasi-static shearing: an inertial number ε̇ d √(ρs/σ3) ≈ 1e-3 here) while the side walls hold σ3,
@@ -259,11 +291,13 @@ def drained_triaxial(grains=300, confinement=10e3, friction_angle=math.radians(3
     compression-positive; σ1, σ3 [Pa]), the peak friction angle φ = asin((σ1 − σ3)/(σ1 + σ3)) at
     the peak of the stress ratio (a moving mean over ±1000 steps), the friction angle over the last 10%
     of the run (towards the critical state), and the mean dilatancy angle from the densest state to the
-    peak, sin ψ = −Δεv/(2Δε1 − Δεv) (compression-positive strains)."""
+    peak, sin ψ = −Δεv/(2Δε1 − Δεv) (compression-positive strains). `rolling_resistance` [-]: the
+    contacts' etaRoll (contact_material), None for freely rolling spheres (Cundall–Strack)."""
     from yade import utils
     _require("strain_rate", strain_rate, 0 < strain_rate <= 0.1, "(0, 0.1] s⁻¹ (faster is no longer quasi-static)")
     _require("final_strain", final_strain, 0 < final_strain < 0.5, "(0, 0.5)")
-    wall_ids, controller = _compacted_box(grains, width, confinement, young, contact_poisson, friction_angle, grain_density, seed)
+    wall_ids, controller = _compacted_box(grains, width, confinement, young, contact_poisson, friction_angle, grain_density, seed,
+                                          rolling_resistance)
     controller.internalCompaction = False
     for _ in range(40):  # back to isotropic equilibrium with the final friction, walls servo-controlled
         O.run(500, True)
@@ -293,6 +327,6 @@ def drained_triaxial(grains=300, confinement=10e3, friction_angle=math.radians(3
     densest = max(range(peak + 1), key=ev.__getitem__)
     lo, hi = (densest, peak) if peak - densest >= 5 else (max(0, peak - 10), min(len(e1) - 1, peak + 10))
     slope = (ev[hi] - ev[lo]) / (e1[hi] - e1[lo])
-    return dict(curves, grains=grains, confinement=confinement, contact_friction_angle=friction_angle,
+    return dict(curves, grains=grains, confinement=confinement, contact_friction_angle=friction_angle, rolling_resistance=rolling_resistance,
                 peak_friction_angle=math.asin(ratio[peak]), peak_axial_strain=e1[peak],
                 final_friction_angle=math.asin(sum(last) / len(last)), dilatancy_angle=math.asin(-slope / (2 - slope)))

@@ -27,7 +27,7 @@ import numpy as np
 import yade.wrapper as w
 from yade import O, Vector3
 
-from .dem import XMIN, XMAX, YMIN, YMAX, ZMIN, ZMAX, _require  # noqa: F401  (the wall order)
+from .dem import XMAX, XMIN, ZMAX, _require, contact_loop, contact_material
 
 
 @dataclass
@@ -56,21 +56,9 @@ class PileSample:
         return np.array([O.bodies[int(i)].state.mass for i in self.grain_ids])
 
 
-def _grain_material(young, contact_poisson, friction_angle, rolling_resistance, density, label):
-    # non-cohesive CohFrictMat: Coulomb friction plus a rolling moment capped at etaRoll × r × Fn
-    return w.CohFrictMat(young=young, poisson=contact_poisson, frictionAngle=friction_angle, density=density, isCohesive=False,
-                         momentRotationLaw=rolling_resistance > 0, etaRoll=rolling_resistance, alphaKr=2.0, label=label)
-
-
 def _engines(gravity, damping):
-    return [
-        w.ForceResetter(),
-        w.InsertionSortCollider([w.Bo1_Sphere_Aabb(), w.Bo1_Box_Aabb()]),
-        w.InteractionLoop([w.Ig2_Sphere_Sphere_ScGeom6D(), w.Ig2_Box_Sphere_ScGeom6D()], [w.Ip2_CohFrictMat_CohFrictMat_CohFrictPhys()],
-                          [w.Law2_ScGeom6D_CohFrictPhys_CohesionMoment(useIncrementalForm=True, always_use_moment_law=False)]),
-        w.FlowEngine(dead=True, label="flow"),
-        w.NewtonIntegrator(damping=damping, gravity=gravity, label="newton"),
-    ]
+    return [w.ForceResetter(), w.InsertionSortCollider([w.Bo1_Sphere_Aabb(), w.Bo1_Box_Aabb()]), contact_loop(0.0),
+            w.FlowEngine(dead=True, label="flow"), w.NewtonIntegrator(damping=damping, gravity=gravity, label="newton")]
 
 
 def _settle(max_steps, unbalanced=0.01, speed=1e-4, grain_ids=None):
@@ -105,6 +93,8 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
     scene.validate()
     _require("scene.still_water_level", scene.still_water_level, scene.still_water_level is not None,
              "a level at or above the pile (PFV models a fully saturated, submerged pile)")
+    _require("scene.crest_lid", scene.crest_lid, scene.crest_lid,
+             "True (without a lid PFV meshes the open water over the crest, and the inflow drains through it)")
     _require("grain_radius", grain_radius, 0 < grain_radius <= scene.pile_height / 8, "(0, pile_height/8] m (at least four grains over the height)")
     _require("radius_spread", radius_spread, 0 <= radius_spread < 1, "[0, 1)")
     _require("slice_width", slice_width, slice_width >= 4 * grain_radius, "[4 grain_radius, inf) m (two grains across)")
@@ -114,10 +104,10 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
     clock = time.time()
     O.reset()
     g = float(np.linalg.norm(gravity))
-    grains_mat = O.materials.append(_grain_material(young, contact_poisson, math.radians(1), 0.0, scene.grain_density, "grains"))
-    walls_mat = O.materials.append(_grain_material(young, contact_poisson, wall_friction_angle, 0.0, 0.0, "walls"))
+    grains_mat = O.materials.append(contact_material(young, contact_poisson, math.radians(1), 0.0, scene.grain_density, "grains"))
+    walls_mat = O.materials.append(contact_material(young, contact_poisson, wall_friction_angle, 0.0, 0.0, "walls"))
     lid_friction_angle = friction_angle if lid_friction_angle is None else lid_friction_angle
-    lid_mat = O.materials.append(_grain_material(young, contact_poisson, lid_friction_angle, 0.0, 0.0, "lid"))
+    lid_mat = O.materials.append(contact_material(young, contact_poisson, lid_friction_angle, 0.0, 0.0, "lid"))
     height, toe = scene.pile_height, scene.toe_x()
     # the flume's walls (PFV's boundaries, ids 0–5), the lid still high; a gate at the toe while the grains are rained in
     top = 3 * height
@@ -155,7 +145,7 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
     # the real contact law from here on: the contacts are made anew from the material (their normal
     # forces come back from the overlaps at once; the shear and rolling springs start from zero)
     O.materials[grains_mat].frictionAngle = friction_angle
-    O.materials[grains_mat].etaRoll = rolling_resistance
+    O.materials[grains_mat].etaRoll = O.materials[grains_mat].etaTwist = rolling_resistance
     O.materials[grains_mat].momentRotationLaw = rolling_resistance > 0
     O.interactions.clear()
     buoyant = g * (1 - scene.water_density / scene.grain_density)
@@ -259,3 +249,68 @@ def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, bound
                   onset_time=None if onset is None else record["time"][onset],
                   steps=int(round((O.time - start) / O.dt)), wall_time=time.time() - clock, grains=len(pile.grain_ids), time_step=O.dt)
     return record
+
+
+def summary(pile, scene, record):
+    """The run's numbers for a report: grains, onset head and time, end displacements, the flux
+    balance before the onset (PFV's fluid is incompressible: what enters leaves), and the cost."""
+    onset = record["onset_index"]
+    before = onset if onset is not None else len(record["time"]) - 1
+    inflow, outflow = record["inflow"][before], record["outflow"][before]
+    return {
+        "grains": int(len(pile.grain_ids)), "base_grains": int(len(pile.base_ids)), "grain_radius_m": pile.grain_radius,
+        "slice_width_m": pile.slice_width, "crest_height_m": pile.crest_height, "lid_pressure_Pa": pile.lid_pressure,
+        "head_start_m": scene.head_start, "head_end_m": scene.head_end, "still_water_level_m": scene.still_water_level,
+        "ramp_time_s": scene.head_ramp_time, "onset_head_m": record["onset_head"], "onset_time_s": record["onset_time"],
+        "toe_displacement_m": record["toe_displacement"][-1], "face_displacement_m": record["face_displacement"][-1],
+        "max_displacement_m": record["max_displacement"][-1],
+        "inflow_before_onset_m3_per_s": inflow, "outflow_before_onset_m3_per_s": outflow,
+        "flux_mismatch_before_onset": abs(inflow - outflow) / max(abs(inflow), 1e-300),
+        "time_step_s": record["time_step"], "steps": record["steps"], "build_wall_s": pile.build_wall_time, "run_wall_s": record["wall_time"],
+        "wall_s_per_simulated_s": record["wall_time"] / record["time"][-1],
+    }
+
+
+def figure(path, pile, scene, record):
+    """Time series (head and probe pressures; toe and face displacement; fluxes) and the grains'
+    displacement at the end, side view, in one PNG."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    t = np.array(record["time"])
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7))
+    ax = axes[0, 0]
+    ax.plot(t, record["inflow_pressure"], "k-", label="inflow wall (excess)")
+    for name, values in record["probes"].items():
+        ax.plot(t, values, label=name)
+    ax.set_ylabel("excess pore pressure [Pa]")
+    ax.legend(fontsize=7)
+    ax = axes[0, 1]
+    ax.plot(t, 1e3 * np.array(record["face_displacement"]), label="lower slope face (mean |u|)")
+    ax.plot(t, 1e3 * np.array(record["toe_displacement"]), label="toe (mean u_x)")
+    if record["onset_index"] is not None:
+        ax.axvline(record["onset_time"], color="r", ls="--", label="onset, head %.3f m" % record["onset_head"])
+    ax.set_ylabel("displacement [mm]")
+    ax.legend(fontsize=7)
+    ax = axes[1, 0]
+    ax.semilogy(t, np.abs(record["inflow"]), label="in (x = 0)")
+    ax.semilogy(t, np.abs(record["outflow"]), "--", label="out (flume end)")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("flux [m³ s⁻¹]")
+    ax.legend(fontsize=7)
+    ax = axes[1, 1]
+    xs = np.linspace(0, scene.flume_length, 200)
+    ax.plot(xs, scene.surface_height(xs), "k-", lw=0.8, label="pile as built")
+    end = pile.positions()
+    moved = np.linalg.norm(end - pile.start_positions, axis=1)
+    dots = ax.scatter(end[:, 0], end[:, 2], c=1e3 * moved, s=4, cmap="viridis", vmin=0, vmax=max(1e3 * 4 * pile.grain_radius, 1e-3))
+    fig.colorbar(dots, ax=ax, label="displacement [mm] (cap: 2 diameters)")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("z [m]")
+    ax.set_title("grains at t = %.2f s" % t[-1], fontsize=9)
+    fig.suptitle("DEM + PFV sand pile: %d grains, head %.3f → %.3f m over %.2f s" % (len(pile.grain_ids), scene.head_start, scene.head_end,
+                                                                                     scene.head_ramp_time))
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

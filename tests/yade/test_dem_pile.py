@@ -1,0 +1,144 @@
+"""The DEM + pore-fluid sand pile (yade_mpm.dem_pile, PFV FlowEngine) on a reduced pile that runs in
+seconds: grains of 7.5 mm radius (H/16) in a 3 cm slice, under two hundred of them, the head rise of
+the MPM's submerged pile compressed to 0.4 s (issue 16)."""
+import dataclasses
+import math
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import yade_mpm  # noqa: F401  (boots YADE)
+from yade import O
+from yade_mpm import dem, dem_pile, sandpile
+
+GRAVITY = (0.0, 0.0, -9.81)
+RADIUS, WIDTH, RAMP = 0.0075, 0.03, 0.4
+ROLLING = 0.05  # etaRoll: a drained triaxial peak near the MPM sand's 36° (test below)
+SCENE = dataclasses.replace(sandpile.SUBMERGED, crest_lid=True, settle_time=0.05, head_ramp_time=RAMP, hold_time=0.15)
+
+
+@pytest.fixture(autouse=True)
+def fresh_scene():
+    """The tests of this module share one pile (built once, below) and restore it themselves."""
+    yield
+
+
+@pytest.fixture(scope="module")
+def pile():
+    built = dem_pile.build(SCENE, GRAVITY, grain_radius=RADIUS, slice_width=WIDTH, rolling_resistance=ROLLING)
+    O.saveTmp("dem_pile")
+    yield built
+    O.reset()
+
+
+def _run(pile, head_end):
+    O.loadTmp("dem_pile")
+    return dem_pile.raise_head(pile, dataclasses.replace(SCENE, head_end=head_end), GRAVITY, record_interval=0.025)
+
+
+@pytest.fixture(scope="module")
+def control(pile):
+    return _run(pile, SCENE.head_start)
+
+
+@pytest.fixture(scope="module")
+def rise(pile):
+    return _run(pile, SCENE.head_end)
+
+
+def test_the_pile_has_the_scenes_shape_on_a_rough_frozen_base(pile):
+    """Carved to the scene's surface: every free grain's centre lies below it (the crest's under the
+    lid); the lid rests on the crest within a grain diameter of the pile height; the base grains are
+    frozen (the rough base) and the toe region holds grains."""
+    positions = pile.start_positions
+    assert np.all(positions[:, 2] <= SCENE.surface_height(positions[:, 0]) + 1e-9)
+    assert SCENE.pile_height - 2 * RADIUS <= pile.crest_height <= SCENE.pile_height + 1e-9
+    assert len(pile.base_ids) > 0 and all(O.bodies[int(i)].state.blockedDOFs == "xyzXYZ" for i in pile.base_ids)
+    assert len(dem_pile._region(pile, SCENE, "toe")) > 0 and len(dem_pile._region(pile, SCENE, "face")) > 0
+    assert pile.buoyant_gravity == pytest.approx(9.81 * (1 - SCENE.water_density / SCENE.grain_density), rel=1e-12)
+
+
+def test_the_pile_stands_without_a_head_difference(control):
+    """Head held at the still water level: no excess pressure anywhere, no flow (PFV's fluxes at
+    round-off), and the settled pile stays where it is (no grain moves a tenth of its radius, no
+    onset)."""
+    assert max(abs(q) for q in control["inflow"] + control["outflow"]) < 1e-7
+    assert max(max(abs(p) for p in values) for values in control["probes"].values()) < 1e-3
+    assert max(control["max_displacement"]) < 0.1 * RADIUS
+    assert control["onset_index"] is None
+
+
+def test_the_rising_head_drives_seepage_through_the_pile_and_fails_its_slope(rise, control):
+    """The head rises 0.12 m (a gradient of about 0.4 over the pile, where the DEM notes report
+    failure): incompressible fluid, so what enters at the inflow wall leaves at the outflow wall
+    (within 1e-6 before the onset, while the grains barely move); the excess pressure falls along the
+    flow path, from the inflow wall over the probes upstream, at the crest's edge, mid-slope and near
+    the toe; the slope yields (compliance onset inside the rise) and moves far more than the pile at
+    rest: the face by over a millimetre, the toe forward."""
+    onset = rise["onset_index"]
+    assert onset is not None and SCENE.head_start < rise["onset_head"] < SCENE.head_end
+    rising = [i for i in range(onset + 1) if rise["head"][i] > SCENE.head_start]
+    assert len(rising) >= 3
+    for i in rising:
+        assert rise["inflow"][i] > 0
+        assert rise["outflow"][i] == pytest.approx(rise["inflow"][i], rel=1e-6)
+        probes = [values[i] for values in rise["probes"].values()]
+        assert rise["inflow_pressure"][i] > probes[0] > probes[1] > probes[2] > probes[3] > -1e-6
+    assert rise["face_displacement"][-1] > 1e-3
+    assert rise["face_displacement"][-1] > 100 * max(control["face_displacement"])
+    assert rise["toe_displacement"][-1] > 0
+
+
+def test_the_summary_reports_what_the_record_holds(pile, rise):
+    """summary() copies the onset and end displacements and states the flux balance before the onset."""
+    s = dem_pile.summary(pile, dataclasses.replace(SCENE, head_end=SCENE.head_end), rise)
+    assert s["onset_head_m"] == rise["onset_head"] and s["grains"] == len(pile.grain_ids)
+    assert s["face_displacement_m"] == rise["face_displacement"][-1]
+    assert s["flux_mismatch_before_onset"] < 1e-6
+    assert s["wall_s_per_simulated_s"] > 0
+
+
+def test_rolling_resistance_gives_the_grains_the_mpm_sands_strength():
+    """Spheres that roll freely are weaker than the 30° slope needs (doc/dem.md: about 28° peak for
+    30° contact friction); capping the rolling and twisting moments at 0.05 r Fn lifts the drained
+    triaxial peak, at the pile's stress level (1 kPa) and contact stiffness, to the MPM sand's φ = 36°
+    within 3° (300 grains: the peak is noisy by about ±1.5°)."""
+    free = dem.drained_triaxial(grains=300, confinement=1e3, young=2e6, final_strain=0.1)
+    rolling = dem.drained_triaxial(grains=300, confinement=1e3, young=2e6, final_strain=0.1, rolling_resistance=ROLLING)
+    assert math.degrees(rolling["peak_friction_angle"]) == pytest.approx(math.degrees(sandpile.SUBMERGED.friction_angle), abs=3)
+    assert rolling["peak_friction_angle"] > free["peak_friction_angle"] + math.radians(4)
+    O.reset()
+
+
+def test_bad_input_is_refused_before_any_work():
+    """A pile in air (no still water), a scene without the crest lid, and grains too large for the
+    pile are refused with the attribute, its value and the valid range."""
+    O.reset()
+    with pytest.raises(ValueError, match=r"scene.still_water_level = None is outside the valid range"):
+        dem_pile.build(sandpile.DEFAULT, GRAVITY)
+    with pytest.raises(ValueError, match=r"scene.crest_lid = False is outside the valid range True"):
+        dem_pile.build(sandpile.SUBMERGED, GRAVITY)
+    with pytest.raises(ValueError, match=r"grain_radius = 0.02 is outside the valid range \(0, pile_height/8\]"):
+        dem_pile.build(SCENE, GRAVITY, grain_radius=0.02)
+    with pytest.raises(ValueError, match=r"rolling_resistance = -0.1 is outside the valid range"):
+        dem_pile.build(SCENE, GRAVITY, rolling_resistance=-0.1)
+    assert len(O.bodies) == 0  # nothing was built
+
+
+def test_the_example_writes_its_summary_series_and_figure(tmp_path):
+    """examples/dem/sandpile.py --quick --control: the pile stands (no onset), and the summary, the
+    time series and the figure are written."""
+    import json
+    root = os.path.join(os.path.dirname(__file__), "..", "..")
+    result = subprocess.run(["yade-double", "-n", "-x", os.path.join(root, "examples", "dem", "sandpile.py"), "--quick", "--control",
+                             "--ramp-time", "0.1", "--out", str(tmp_path)], capture_output=True, text=True, timeout=300,
+                            stdin=subprocess.DEVNULL, env=dict(os.environ, HOME=str(tmp_path)))
+    assert result.returncode == 0, result.stderr[-3000:]
+    summary = json.load(open(tmp_path / "summary.json"))
+    assert summary["control"] and summary["onset_head_m"] is None and summary["head_end_m"] == summary["head_start_m"]
+    assert summary["max_displacement_m"] < 0.1 * summary["grain_radius_m"]
+    rows = open(tmp_path / "time_series.csv").read().splitlines()
+    assert rows[0].startswith("time_s,head_m") and len(rows) > 10
+    assert (tmp_path / "sandpile_dem.png").stat().st_size > 10000
