@@ -168,10 +168,7 @@ def head_table(t):
 
 # --- probes and the toe ----------------------------------------------------------------------------
 toe = SCENE.toe_x()
-PROBES = {"upstream x=0.05": (0.05, 0.5 * SCENE.flume_width, 0.02),
-          "crest edge x=0.10": (SCENE.crest_length, 0.5 * SCENE.flume_width, 0.02),
-          "mid slope x=0.20": (0.20, 0.5 * SCENE.flume_width, 0.02),
-          "near toe x=0.27": (0.27, 0.5 * SCENE.flume_width, 0.01)}
+PROBES = SCENE.probe_points()  # the same points in the DEM pile (yade_mpm.dem_pile)
 # the toe region: solid points within two cells of the toe along the base
 toe_points = np.flatnonzero((start_positions[:, 0] > toe - 2 * CELL) & (start_positions[:, 2] < 2 * CELL))
 # the lower slope face, where seepage exits and the slide starts: solid points within two cells of

@@ -92,3 +92,14 @@ def mobilised_volume(start_positions, positions, volumes, displacement):
     v = np.asarray(volumes, dtype=float)
     total = float(v.sum())
     return float(v[moved].sum()), (float(v[moved].sum()) / total if total > 0 else 0.0)
+
+
+def falls_below(loads, values, level=1.0):
+    """The load at which `values` (e.g. a factor of safety evaluated at a rising head) first falls
+    from ≥ level to < level, linear between the two records; None entries (no evaluation) are
+    skipped; None if it never does."""
+    pairs = [(q, v) for q, v in zip(loads, values) if v is not None]
+    for (q0, v0), (q1, v1) in zip(pairs, pairs[1:]):
+        if v0 >= level > v1:
+            return q0 + (v0 - level) / (v0 - v1) * (q1 - q0)
+    return None

@@ -19,6 +19,7 @@ boundary order); the axis z is vertical and x runs down the flume, as in the MPM
 are spheres with rolling resistance (``CohFrictMat`` with ``etaRoll``, non-cohesive): spheres that
 roll freely are weaker than a 30° slope of real sand (doc/dem.md, the triaxial tests).
 """
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -184,7 +185,7 @@ def excess_head_pressure(scene, gravity, t):
     return scene.water_density * float(np.linalg.norm(gravity)) * (scene.head(t) - scene.still_water_level)
 
 
-def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, boundary_update_steps=10):
+def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, boundary_update_steps=10, on_record=None):
     """The head rise on a built pile: PFV switched on (incompressible fluid of `viscosity` [Pa s],
     default the scene's water), the inflow wall at the excess pressure of scene.head(t) above the
     still water (updated every `boundary_update_steps` steps), the outflow wall at 0, the rest
@@ -193,8 +194,9 @@ def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, bound
     doc/dem.md). Every `record_interval` [s] it records the head, the pore pressure at the scene's
     probe points (mid-slice), the fluxes through the inflow and outflow walls [m³ s⁻¹], the free
     grains' kinetic energy [J], the mean toe displacement along x and the mean displacement of the
-    lower slope face [m]. Returns a dict of lists with the onsets (yade_mpm.analysis: kinetic and
-    compliance) and the wall time."""
+    lower slope face [m]; `on_record(record, flow)`, if given, is called after each record (the
+    example evaluates the limit equilibrium there). Returns a dict of lists with the onset
+    (yade_mpm.analysis.compliance_onset, the MPM example's criterion) and the wall time."""
     from . import analysis
     _require("record_interval", record_interval, record_interval > 0, "(0, inf) s")
     _require("boundary_update_steps", boundary_update_steps, int(boundary_update_steps) >= 1, "[1, inf)")
@@ -241,6 +243,8 @@ def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, bound
         record["max_displacement"].append(float(np.linalg.norm(displacement, axis=1).max()))
         for name, location in probes.items():
             record["probes"][name].append(flow.getPorePressure(Vector3(*location)))
+        if on_record is not None:
+            on_record(record, flow)
     flow.dead = True
     # the MPM example's criterion (the kinetic one fires at the ramp's start: a pile at rest gains
     # kinetic energy as its elastic response follows the rising head)
@@ -249,6 +253,26 @@ def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, bound
                   onset_time=None if onset is None else record["time"][onset],
                   steps=int(round((O.time - start) / O.dt)), wall_time=time.time() - clock, grains=len(pile.grain_ids), time_step=O.dt)
     return record
+
+
+def limit_equilibrium(pile, scene, gravity, flow, friction_angle, dilatancy_angle, min_depth=None):
+    """Bishop's critical circle of the DEM pile now (yade_mpm.sandpile.limit_equilibrium, the MPM's
+    check): the grains' buoyant weights (the frozen base included), the PFV excess pore pressure
+    sampled on a lattice of one grain diameter's spacing inside the pile as built, averaged over
+    the slice; bins of two diameters; the ground one radius above the highest grain centres; the strength c = 0, φ = `friction_angle`, ψ =
+    `dilatancy_angle` [rad] (the DEM sand's, measured by dem.drained_triaxial) reduced by Davis;
+    slides at least `min_depth` [m] deep (default two diameters). Returns the CriticalCircle."""
+    from types import SimpleNamespace
+    from . import sandpile
+    diameter = 2 * pile.grain_radius
+    section = dataclasses.replace(scene, flume_width=pile.slice_width, friction_angle=friction_angle, dilatancy_angle=dilatancy_angle)
+    lattice, _ = sandpile.pile_points(section, cell_size=2 * diameter, points_per_cell=2)
+    pressures = np.array([flow.getPorePressure(Vector3(*p)) for p in lattice])
+    ids = list(pile.grain_ids) + list(pile.base_ids)
+    solid = SimpleNamespace(pos=np.array([O.bodies[int(i)].state.pos for i in ids]), mass=np.array([O.bodies[int(i)].state.mass for i in ids]))
+    water = SimpleNamespace(pos=lattice, mass=np.zeros(len(lattice)), porePressure=pressures)
+    return sandpile.limit_equilibrium(section, solid, water, gravity, cell_size=2 * diameter, point_spacing=diameter,
+                                      min_depth=2 * diameter if min_depth is None else min_depth)
 
 
 def summary(pile, scene, record):
