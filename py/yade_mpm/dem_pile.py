@@ -317,8 +317,8 @@ def figure(path, pile, scene, record):
     ax.set_ylabel("displacement [mm]")
     ax.legend(fontsize=7)
     ax = axes[1, 0]
-    ax.semilogy(t, np.abs(record["inflow"]), label="in (x = 0)")
-    ax.semilogy(t, np.abs(record["outflow"]), "--", label="out (flume end)")
+    ax.plot(t, record["inflow"], label="in (x = 0)")
+    ax.plot(t, record["outflow"], "--", label="out (flume end)")
     ax.set_xlabel("time [s]")
     ax.set_ylabel("flux [m³ s⁻¹]")
     ax.legend(fontsize=7)
@@ -338,3 +338,66 @@ def figure(path, pile, scene, record):
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+QUICK = {"grain_radius": 0.0075, "ramp_time": 0.4}     # under two hundred grains, about 30 s with the triaxial
+DEFAULT_CASE = {"grain_radius": 0.004, "ramp_time": 4.0}  # about 1400 grains
+
+
+def run_case(out_dir, gravity, quick=False, control=False, ramp_time=None, grain_radius=None, slice_width=0.03, rolling_resistance=0.05,
+             young=2e6, contact_friction_angle=math.radians(30), scene=None):
+    """The whole DEM pile case, as examples/dem/sandpile.py and `python3 -m yade_mpm.compare sandpile`
+    run it: the MPM's submerged, lidded pile (`scene`, default yade_mpm.sandpile.SUBMERGED with the
+    crest lid) with its head history compressed to a rise of `ramp_time` [s] (settling 5% and holding
+    25% of it; `control`: no rise); a drained triaxial test on the same grains (300, at the crest's
+    mid-depth effective stress) for the sand's φ and ψ; the pile built and the head raised, with
+    Bishop's factor every other record. Writes out_dir/summary.json, time_series.csv and
+    sandpile_dem.png; returns the summary."""
+    import csv
+    import json
+    import os
+    from . import analysis, calibrate, dem, sandpile
+    preset = QUICK if quick else DEFAULT_CASE
+    ramp = preset["ramp_time"] if ramp_time is None else ramp_time
+    radius = preset["grain_radius"] if grain_radius is None else grain_radius
+    _require("ramp_time", ramp, ramp > 0, "(0, inf) s")
+    base = dataclasses.replace(sandpile.SUBMERGED, crest_lid=True) if scene is None else scene
+    scene = dataclasses.replace(base, settle_time=0.05 * ramp, head_ramp_time=ramp, hold_time=0.25 * ramp,
+                                head_end=base.head_start if control else base.head_end)
+    g = float(np.linalg.norm(gravity))
+    os.makedirs(out_dir, exist_ok=True)
+    confinement = (scene.grain_density - scene.water_density) * (1 - scene.porosity) * g * 0.5 * scene.pile_height
+    triaxial = dem.drained_triaxial(grains=300, confinement=confinement, friction_angle=contact_friction_angle, young=young,
+                                    grain_density=scene.grain_density, final_strain=0.1, rolling_resistance=rolling_resistance)
+    strength = calibrate.strength_from_triaxial(triaxial)
+    pile = build(scene, gravity, grain_radius=radius, slice_width=slice_width, friction_angle=contact_friction_angle,
+                 rolling_resistance=rolling_resistance, young=young)
+    lem = {"heads_m": [], "factors": []}
+
+    def bishop(record, flow):
+        if len(record["time"]) % 2 == 0:
+            circle = limit_equilibrium(pile, scene, gravity, flow, strength["frictionAngle"], strength["dilatancyAngle"])
+            lem["heads_m"].append(record["head"][-1])
+            lem["factors"].append(circle.factor)
+
+    record = raise_head(pile, scene, gravity, record_interval=ramp / 40, on_record=bishop)
+    result = summary(pile, scene, record)
+    result.update(control=control, rolling_resistance=rolling_resistance, contact_friction_angle_deg=math.degrees(contact_friction_angle),
+                  contact_young_Pa=young, gravity_m_per_s2=list(gravity), probe_points=scene.probe_points(slice_width),
+                  triaxial={"grains": 300, "confinement_Pa": confinement, "peak_friction_angle_deg": math.degrees(strength["frictionAngle"]),
+                            "residual_friction_angle_deg": math.degrees(strength["residualFrictionAngle"]),
+                            "dilatancy_angle_deg": math.degrees(strength["dilatancyAngle"])},
+                  limit_equilibrium=dict(lem, method="Bishop simplified, critical circle at least 2 grain diameters deep, Davis (1968) strength"),
+                  lem_onset_head_m=analysis.falls_below(lem["heads_m"], lem["factors"]))
+    with open(os.path.join(out_dir, "summary.json"), "w") as f:
+        json.dump(result, f, indent=1)
+    names = list(record["probes"])
+    with open(os.path.join(out_dir, "time_series.csv"), "w", newline="") as f:
+        out = csv.writer(f)
+        out.writerow(["time_s", "head_m", "inflow_m3_per_s", "outflow_m3_per_s", "kinetic_energy_J", "toe_displacement_m", "face_displacement_m"]
+                     + ["p_%s_Pa" % n.replace(" ", "_") for n in names])
+        for i in range(len(record["time"])):
+            out.writerow([record[k][i] for k in ("time", "head", "inflow", "outflow", "kinetic_energy", "toe_displacement", "face_displacement")]
+                         + [record["probes"][n][i] for n in names])
+    figure(os.path.join(out_dir, "sandpile_dem.png"), pile, scene, record)
+    return result
