@@ -2,6 +2,7 @@
 
     python3 -m yade_mpm.compare oedometer [--quick] [--out DIR]
     python3 -m yade_mpm.compare tradeoffs [--quick] [--out DIR]
+    python3 -m yade_mpm.compare sandpile --mpm-run DIR [--dem-run DIR | --quick] [--out DIR]   (yade_mpm.compare_pile)
     yade-double -n -x examples/dem/compare.py oedometer [--quick] [--out DIR]
 
 The oedometer: a sphere assembly (yade_mpm.dem) is compacted, its oedometric modulus, lateral stress
@@ -318,8 +319,12 @@ def _tradeoff_figure(path, rows):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m yade_mpm.compare", description=__doc__.split("\n")[0])
-    parser.add_argument("case", choices=["oedometer", "tradeoffs", "_dem-oedometer", "_mpm-oedometer", "_mpm-variants"],
-                        help="oedometer: both models side by side; tradeoffs: error against cost for each knob (doc/tradeoffs.md)")
+    parser.add_argument("case", choices=["oedometer", "tradeoffs", "sandpile", "_dem-oedometer", "_mpm-oedometer", "_mpm-variants", "_dem-sandpile"],
+                        help="oedometer: both models side by side; tradeoffs: error against cost for each knob (doc/tradeoffs.md); "
+                             "sandpile: an MPM pile run against the DEM pile (yade_mpm.compare_pile)")
+    parser.add_argument("--mpm-run", help="sandpile: the output directory of an examples/sandpile/sandpile.py --submerged --crest-lid run")
+    parser.add_argument("--gravity", type=float, nargs=3, help=argparse.SUPPRESS)
+    parser.add_argument("--dem-run", help="sandpile: the output directory of an examples/dem/sandpile.py run (default: run it now)")
     parser.add_argument("--grains", type=int, help=argparse.SUPPRESS)
     parser.add_argument("--quick", action="store_true", help="300 grains and 20 cells over H (about a minute) instead of 1000 and 40")
     parser.add_argument("--out", default="compare-out", help="output directory (default: ./compare-out)")
@@ -327,6 +332,30 @@ def main(argv=None):
     parser.add_argument("--from-dem", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     grains, cells = (300, 20) if args.quick else (1000, 40)
+    if args.case == "_dem-sandpile":
+        import yade_mpm  # noqa: F401  (boots YADE)
+        from . import dem_pile
+        with open(args.json, "w") as f:
+            json.dump(dem_pile.run_case(args.out, tuple(args.gravity), quick=args.quick), f)
+        return 0
+    if args.case == "sandpile":
+        from . import compare_pile
+        if not args.mpm_run:
+            parser.error("sandpile needs --mpm-run DIR (an examples/sandpile/sandpile.py --submerged --crest-lid run)")
+        dem_dir = args.dem_run
+        memory = None
+        if dem_dir is None:  # the DEM pile under the MPM run's gravity
+            gravity = compare_pile.read_run(args.mpm_run)[0]["gravity_m_per_s2"]
+            dem_dir = os.path.join(args.out, "dem-run")
+            os.makedirs(dem_dir, exist_ok=True)
+            memory = _child(["_dem-sandpile", "--out", dem_dir, "--gravity"] + [repr(float(c)) for c in gravity] + (["--quick"] if args.quick else []),
+                            os.path.join(dem_dir, "child.json"))["peak_memory_MiB"]
+            os.remove(os.path.join(dem_dir, "child.json"))
+        result = compare_pile.compare(args.mpm_run, dem_dir)
+        if memory is not None:
+            result["dem"]["peak_memory_MiB"] = memory
+        print("wrote %s" % compare_pile.report(args.out, result))
+        return 0
     if args.case == "_dem-oedometer":
         import yade_mpm  # noqa: F401  (boots YADE)
         with open(args.json, "w") as f:
