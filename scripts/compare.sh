@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Comparison command (not a test): MPM against DEM + PFV on the oedometer, full size (1000 grains,
+# Comparison commands (not tests): MPM against DEM + PFV on the oedometer, full size (1000 grains,
 # 40 MPM cells; about 1.5 minutes on 2 cores). Writes doc/compare/oedometer/{report.md,report.json,oedometer.png}
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -8,3 +8,12 @@ build="${MPM_BUILD_DIR:-$root/build}"
 PYTHONPATH="$build/python" /usr/bin/python3 -m yade_mpm.compare oedometer --out "$root/doc/compare/oedometer" "$@"
 # and the speed-for-accuracy study: doc/tradeoffs.md with doc/figures/tradeoffs.{png,json} (about 5 minutes)
 PYTHONPATH="$build/python" /usr/bin/python3 -m yade_mpm.compare tradeoffs --out "$root/doc" "$@"
+# and the sand pile: the MPM's submerged, lidded quick pile to 40 s (about 10 minutes; or reuse a run
+# with MPM_PILE_RUN=DIR), then the DEM + PFV pile (about 1400 grains, 10–20 minutes) and the report in
+# doc/compare/sandpile/ (report.md, report.json, sandpile.png; the DEM run's files in dem-run/)
+mpm_run="${MPM_PILE_RUN:-$(mktemp -d)}"
+if [ ! -f "$mpm_run/summary.json" ]; then
+  PYTHONPATH="$build/python" yade-double -j2 -n -x "$root/examples/sandpile/sandpile.py" --quick --submerged --crest-lid --lid-friction 0.7 \
+    --scheme semi-implicit --inertia-scale 100 --duration 40 --out "$mpm_run"
+fi
+PYTHONPATH="$build/python" /usr/bin/python3 -m yade_mpm.compare sandpile --mpm-run "$mpm_run" --out "$root/doc/compare/sandpile" "$@"

@@ -103,3 +103,26 @@ def falls_below(loads, values, level=1.0):
         if v0 >= level > v1:
             return q0 + (v0 - level) / (v0 - v1) * (q1 - q0)
     return None
+
+
+def sliding_surface(start_positions, moving, bin_width, ground_height, offset=0.0, x_max=None):
+    """The base of a sliding mass in the undeformed configuration: in each column of `bin_width` [m]
+    along x, the lowest start position (x, z) [m] of the bodies flagged `moving`, lowered by `offset`
+    [m] (half a point spacing, or a grain radius). `ground_height(x)` is the ground's height before
+    the slide [m]. Returns None if nothing moves, else the surface's points (x_m, z_m) and its scarp
+    and exit x, lowest z, exit z and greatest depth below the ground."""
+    start, moving = np.asarray(start_positions, dtype=float), np.asarray(moving, dtype=bool)
+    if not moving.any():
+        return None
+    x0, z0 = start[:, 0], start[:, 2]
+    top = x0.max() if x_max is None else x_max
+    xs, zs = [], []
+    for lo in np.arange(x0.min(), top + bin_width, bin_width):
+        column = moving & (x0 >= lo) & (x0 < lo + bin_width)
+        if column.any():
+            xs.append(lo + 0.5 * bin_width)
+            zs.append(float(z0[column].min()) - offset)
+    xs, zs = np.array(xs), np.array(zs)
+    depth = np.asarray(ground_height(xs), dtype=float) - zs
+    return {"x_m": xs.tolist(), "z_m": zs.tolist(), "scarp_x_m": float(xs.min()), "exit_x_m": float(xs.max()), "lowest_z_m": float(zs.min()),
+            "exit_z_m": float(zs[np.argmax(xs)]), "max_depth_below_surface_m": float(depth.max())}

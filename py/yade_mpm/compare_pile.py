@@ -84,7 +84,8 @@ def _side(model, summary, columns, width, still, unit_weight, water_density):
                  "peak_friction_angle_deg": math.degrees(summary["scene"]["friction_angle"]),
                  "dilatancy_angle_deg": math.degrees(summary["scene"]["dilatancy_angle"])}
     conductance = discharge / (head[late] - still)
-    return dict(extra, model=model, onset_head_m=onset, lem_onset_head_m=lem, bodies=bodies, wall_s=wall, simulated_s=simulated,
+    return dict(extra, model=model, onset_head_m=onset, sliding_surface=summary.get("sliding_surface"),
+                first_mobilised_zone=summary.get("first_mobilised_zone"), lem_onset_head_m=lem, bodies=bodies, wall_s=wall, simulated_s=simulated,
                 head_rise_m=float(np.nanmax(head) - still), wall_s_per_simulated_s=wall / simulated,
                 discharge_per_width_per_excess_head_m_per_s=float(np.median(conductance)) if len(late) else None,
                 peak_memory_MiB=summary.get("peak_memory_MiB"))
@@ -146,6 +147,18 @@ def _m(value):
     return "—" if value is None else "%.3f" % value
 
 
+def _zone(zone):
+    if not zone:
+        return "—"
+    return "%.3f–%.3f; %.3f–%.3f" % tuple(zone["x_range_m"] + zone["z_range_m"])
+
+
+def _surface(surface):
+    if not surface:
+        return "—"
+    return "%.3f, %.3f, %.3f" % (surface["scarp_x_m"], surface["exit_x_m"], surface["max_depth_below_surface_m"])
+
+
 def report(out_dir, result):
     """Writes out_dir/report.md, report.json and sandpile.png; returns the Markdown path."""
     os.makedirs(out_dir, exist_ok=True)
@@ -170,6 +183,8 @@ def report(out_dir, result):
         % (mpm["peak_friction_angle_deg"], mpm["dilatancy_angle_deg"], dem["peak_friction_angle_deg"], dem["dilatancy_angle_deg"]),
         "| discharge per width and excess head before the onset [m s⁻¹] | %.3g | %.3g |"
         % (mpm["discharge_per_width_per_excess_head_m_per_s"] or math.nan, dem["discharge_per_width_per_excess_head_m_per_s"] or math.nan),
+        "| first mobilised zone at the onset (x range; z range) [m] | %s | %s |" % tuple(_zone(s["first_mobilised_zone"]) for s in (mpm, dem)),
+        "| sliding surface at the end: scarp x, exit x, greatest depth [m] | %s | %s |" % tuple(_surface(s["sliding_surface"]) for s in (mpm, dem)),
         "| bodies | %s | %s |" % (mpm["bodies"], dem["bodies"]),
         "| simulated time [s] | %.1f | %.2f (the rise compressed) |" % (mpm["simulated_s"], dem["simulated_s"]),
         "| wall time [s] | %.0f | %.0f |" % (mpm["wall_s"], dem["wall_s"]),

@@ -223,6 +223,7 @@ def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, bound
     record = {name: [] for name in ("time", "head", "inflow_pressure", "inflow", "outflow", "kinetic_energy", "toe_displacement",
                                     "face_displacement", "max_displacement")}
     record["probes"] = {name: [] for name in probes}
+    record["positions"] = []  # the free grains' centres at each record (for the mobilised zone; not written out)
     steps_per_record = max(1, int(round(record_interval / O.dt)))
     while O.time - start < scene.duration() - 0.5 * O.dt:
         for step in range(steps_per_record):
@@ -231,6 +232,7 @@ def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, bound
                 flow.bndCondValue = [inflow_pressure() if f == XMIN else 0.0 for f in range(6)]
                 flow.updateBCs()
         positions, velocities = pile.positions(), pile.velocities()
+        record["positions"].append(positions)
         displacement = positions - pile.start_positions
         record["time"].append(O.time - start)
         record["head"].append(scene.head(O.time - start))
@@ -275,10 +277,26 @@ def limit_equilibrium(pile, scene, gravity, flow, friction_angle, dilatancy_angl
                                       min_depth=2 * diameter if min_depth is None else min_depth)
 
 
+def mobilised_zone(pile, positions, fraction=0.1):
+    """Where the motion concentrates: the `fraction` of the free grains displaced most at
+    `positions` (rows of pile.grain_ids), as their start positions' x and z range and centroid [m]."""
+    moved = np.linalg.norm(positions - pile.start_positions, axis=1)
+    chosen = np.argsort(moved)[-max(1, int(round(fraction * len(moved)))):]
+    x, z = pile.start_positions[chosen, 0], pile.start_positions[chosen, 2]
+    return {"x_range_m": [float(x.min()), float(x.max())], "z_range_m": [float(z.min()), float(z.max())],
+            "centroid_m": [float(x.mean()), float(z.mean())], "least_displacement_m": float(moved[chosen].min()), "grains": int(len(chosen))}
+
+
 def summary(pile, scene, record):
-    """The run's numbers for a report: grains, onset head and time, end displacements, the flux
+    """The run's numbers for a report: grains, onset head and time, end displacements, the first
+    mobilised zone (the tenth of the grains displaced most at the onset) and the sliding surface at
+    the end (under the grains displaced by more than a radius, in their start positions), the flux
     balance before the onset (PFV's fluid is incompressible: what enters leaves), and the cost."""
+    from . import analysis
     onset = record["onset_index"]
+    end = record["positions"][-1]
+    sliding = analysis.sliding_surface(pile.start_positions, np.linalg.norm(end - pile.start_positions, axis=1) > pile.grain_radius,
+                                       4 * pile.grain_radius, scene.surface_height, offset=pile.grain_radius)
     before = onset if onset is not None else len(record["time"]) - 1
     inflow, outflow = record["inflow"][before], record["outflow"][before]
     return {
@@ -289,6 +307,8 @@ def summary(pile, scene, record):
         "onset_head_m": record["onset_head"], "onset_time_s": record["onset_time"],
         "toe_displacement_m": record["toe_displacement"][-1], "face_displacement_m": record["face_displacement"][-1],
         "max_displacement_m": record["max_displacement"][-1],
+        "first_mobilised_zone": None if onset is None else mobilised_zone(pile, record["positions"][onset]),
+        "sliding_surface": sliding,
         "inflow_before_onset_m3_per_s": inflow, "outflow_before_onset_m3_per_s": outflow,
         "flux_mismatch_before_onset": abs(inflow - outflow) / max(abs(inflow), 1e-300),
         "time_step_s": record["time_step"], "steps": record["steps"], "build_wall_s": pile.build_wall_time, "run_wall_s": record["wall_time"],

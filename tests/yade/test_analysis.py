@@ -1,4 +1,6 @@
 """yade_mpm.analysis on synthetic data whose answers are known by construction."""
+import math
+
 import numpy as np
 import pytest
 
@@ -63,3 +65,24 @@ def test_compliance_onset_is_where_the_load_displacement_curve_softens_tenfold()
     assert analysis.compliance_onset(heads, c * (heads - 0.15)) is None
     with pytest.raises(ValueError, match="ratio"):
         analysis.compliance_onset(heads, u, ratio=1.0)
+
+
+def test_sliding_surface_is_the_base_of_the_moving_mass_in_its_start_positions():
+    """Points of a 30° slope on a lattice; those above a plane 2 cm under the slope face move: the
+    surface found lies one offset under the lowest moving point of each column, between the first and
+    last moving columns, and its depth below the ground is the plane's 2 cm to within a lattice
+    spacing (the lowest moving point of a column lies up to a spacing above the plane, the offset
+    puts the surface half a spacing below it, and the column's ground is read at its centre)."""
+    spacing, slope = 0.005, math.tan(math.radians(30))
+    ground = lambda x: np.clip(0.12 - (np.asarray(x) - 0.1) * slope, 0, 0.12)  # noqa: E731
+    xs, zs = np.meshgrid(np.arange(0.0025, 0.3, spacing), np.arange(0.0025, 0.12, spacing), indexing="ij")
+    inside = zs < ground(xs)
+    start = np.stack([xs[inside], np.zeros(inside.sum()), zs[inside]], axis=1)
+    moving = (start[:, 0] > 0.1) & (start[:, 2] > ground(start[:, 0]) - 0.02)
+    surface = analysis.sliding_surface(start, moving, spacing, ground, offset=0.5 * spacing)
+    assert surface["scarp_x_m"] == pytest.approx(start[moving, 0].min(), abs=spacing)  # bin centres vs points
+    assert surface["exit_x_m"] == pytest.approx(start[moving, 0].max(), abs=spacing)
+    depth = ground(np.array(surface["x_m"])) - np.array(surface["z_m"])
+    above_base = ground(np.array(surface["x_m"])) > 0.02 + spacing  # near the toe the moving mass reaches the base
+    assert above_base.sum() > 20 and np.all(np.abs(depth[above_base] - 0.02) <= spacing)
+    assert analysis.sliding_surface(start, np.zeros(len(start), bool), spacing, ground) is None
