@@ -210,9 +210,11 @@ def _flow_engine():
 _pfv_solved = [False]  # whether PFV has solved on the current sample (oedometer_sample resets it)
 
 
-def _configure_flow(viscosity, pressure_faces):
-    """Switch PFV on: incompressible fluid of `viscosity` [Pa s]; `pressure_faces` maps face index →
-    imposed pressure [Pa]; the other faces are impermeable."""
+def switch_flow_on(viscosity, pressure_faces):
+    """PFV (the engine labelled "flow") on: incompressible fluid of `viscosity` [Pa s], CHOLMOD, the
+    mesh rebuilt every 200 steps or when pores deform by 30%, the walls' own positions as the
+    boundaries; `pressure_faces` maps wall index (xMin..zMax) → imposed pressure [Pa], the other
+    walls impermeable. Returns the engine."""
     flow = _flow_engine()
     flow.dead = False
     flow.viscosity = viscosity
@@ -223,6 +225,12 @@ def _configure_flow(viscosity, pressure_faces):
     flow.boundaryUseMaxMin = [0] * 6
     flow.bndCondIsPressure = [1 if f in pressure_faces else 0 for f in range(6)]
     flow.bndCondValue = [pressure_faces.get(f, 0.0) for f in range(6)]
+    return flow
+
+
+def _configure_flow(viscosity, pressure_faces):
+    """switch_flow_on on the oedometer sample, and a new mesh from the next step on."""
+    flow = switch_flow_on(viscosity, pressure_faces)
     if _pfv_solved[0]:  # before its first solve PFV has nothing to update (and says so)
         flow.updateBCs()
     flow.updateTriangulation = True  # a new mesh: conductances with this viscosity (in use from the step after)

@@ -28,7 +28,7 @@ import numpy as np
 import yade.wrapper as w
 from yade import O, Vector3
 
-from .dem import XMAX, XMIN, ZMAX, _require, contact_loop, contact_material
+from .dem import XMAX, XMIN, ZMAX, _require, contact_loop, contact_material, switch_flow_on
 
 
 @dataclass
@@ -202,15 +202,7 @@ def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, bound
     _require("boundary_update_steps", boundary_update_steps, int(boundary_update_steps) >= 1, "[1, inf)")
     viscosity = scene.water_viscosity if viscosity is None else viscosity
     _require("viscosity", viscosity, viscosity > 0, "(0, inf) Pa s")
-    flow = O.engines[[e.label for e in O.engines].index("flow")]
-    flow.dead = False
-    flow.viscosity = viscosity
-    flow.permeabilityFactor = 1
-    flow.useSolver = 3  # CHOLMOD
-    flow.defTolerance = 0.3
-    flow.meshUpdateInterval = 200
-    flow.boundaryUseMaxMin = [0] * 6
-    flow.bndCondIsPressure = [1 if f in (XMIN, XMAX) else 0 for f in range(6)]
+    flow = switch_flow_on(viscosity, {XMIN: 0.0, XMAX: 0.0})  # the inflow's value is set below, once the clock starts
 
     def inflow_pressure():
         return excess_head_pressure(scene, gravity, O.time - start)
