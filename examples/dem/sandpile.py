@@ -12,6 +12,8 @@ which the slope should fail, next to the head at which it does (yade_mpm.dem_pil
 Writes DIR/summary.json, DIR/time_series.csv, DIR/sandpile_dem.png.
 """
 import argparse
+import os
+import sys
 
 from yade_mpm import dem_pile
 
@@ -23,10 +25,11 @@ parser.add_argument("--grain-radius", type=float, help="mean grain radius [m] (d
 parser.add_argument("--slice-width", type=float, default=0.03, help="width of the flume slice [m] (default 0.03)")
 parser.add_argument("--rolling-resistance", type=float, default=0.05,
                     help="contact etaRoll [-] (default 0.05: a drained triaxial peak of about 36°, the MPM sand's φ)")
-parser.add_argument("--out", default="out-dem-sandpile", help="output directory")
+parser.add_argument("--out", help="output directory (default: out or out-quick beside this script)")
 args = parser.parse_args()
+out = args.out or os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "out-quick" if args.quick else "out")
 GRAVITY = (0.0, 0.0, -9.81)  # [m s⁻²]
-s = dem_pile.run_case(args.out, GRAVITY, quick=args.quick, control=args.control, ramp_time=args.ramp_time, grain_radius=args.grain_radius,
+s = dem_pile.run_case(out, GRAVITY, quick=args.quick, control=args.control, ramp_time=args.ramp_time, grain_radius=args.grain_radius,
                       slice_width=args.slice_width, rolling_resistance=args.rolling_resistance)
 
 
@@ -36,4 +39,4 @@ def metres(value):
 
 print("%d grains; triaxial peak φ %.1f°; onset head %s (Bishop: %s); toe %.1f mm, face %.1f mm at the end; %.0f s wall; wrote %s"
       % (s["grains"], s["triaxial"]["peak_friction_angle_deg"], metres(s["onset_head_m"]), metres(s["lem_onset_head_m"]),
-         1e3 * s["toe_displacement_m"], 1e3 * s["face_displacement_m"], s["run_wall_s"], args.out))
+         1e3 * s["toe_displacement_m"], 1e3 * s["face_displacement_m"], s["run_wall_s"], out))
