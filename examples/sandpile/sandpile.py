@@ -38,6 +38,7 @@ import dataclasses
 import json
 import math
 import os
+import resource
 import sys
 import time
 
@@ -350,6 +351,7 @@ summary = {
     "explicit_steps": int(engine.solverSteps),
     "critical_time_step_s": engine.criticalTimeStep,
     "run_time_s": run_time,
+    "peak_memory_MiB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,  # of this process (YADE included)
     "threads": int(O.numThreads),
     "stable_before_rise": {"toe_displacement_m": settled["toe_displacement_m"] if settled else None,
                            "face_displacement_m": settled["face_displacement_m"] if settled else None,

@@ -369,6 +369,7 @@ def run_case(out_dir, gravity, quick=False, control=False, ramp_time=None, grain
     import csv
     import json
     import os
+    import resource
     from . import analysis, calibrate, dem, sandpile
     preset = QUICK if quick else DEFAULT_CASE
     ramp = preset["ramp_time"] if ramp_time is None else ramp_time
@@ -401,7 +402,8 @@ def run_case(out_dir, gravity, quick=False, control=False, ramp_time=None, grain
                             "residual_friction_angle_deg": math.degrees(strength["residualFrictionAngle"]),
                             "dilatancy_angle_deg": math.degrees(strength["dilatancyAngle"])},
                   limit_equilibrium=dict(lem, method="Bishop simplified, critical circle at least 2 grain diameters deep, Davis (1968) strength"),
-                  lem_onset_head_m=analysis.falls_below(lem["heads_m"], lem["factors"]))
+                  lem_onset_head_m=analysis.falls_below(lem["heads_m"], lem["factors"]),
+                  peak_memory_MiB=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)  # of this process (YADE included)
     with open(os.path.join(out_dir, "summary.json"), "w") as f:
         json.dump(result, f, indent=1)
     names = list(record["probes"])
