@@ -2,9 +2,15 @@
 ``FlowEngine``) in a slice of the MPM pile's flume, under the same head history (issue 16; the facts
 behind the set-up are in doc/dem.md, "The sand pile").
 
-    scene = yade_mpm.sandpile.SUBMERGED_LIDDED            # geometry and heads of the MPM pile
-    pile = yade_mpm.dem_pile.build(scene)                 # deposit, carve, freeze a rough base, settle
-    run = yade_mpm.dem_pile.raise_head(pile, scene.with_head_history(ramp_time=2.0))
+    g = (0, 0, -9.81)
+    scene = dataclasses.replace(yade_mpm.sandpile.SUBMERGED, crest_lid=True,   # the MPM pile's geometry and heads,
+                                settle_time=0.2, head_ramp_time=4.0, hold_time=1.0)  # the rise compressed to 4 s
+    pile = yade_mpm.dem_pile.build(scene, g)             # rain, carve, freeze a rough base, settle under the lid
+    record = yade_mpm.dem_pile.raise_head(pile, scene, g)  # PFV on, the inflow's excess head follows scene.head(t)
+    record["onset_head"]
+
+or the whole case with a triaxial test, Bishop's check and the outputs: ``run_case`` (the example
+examples/dem/sandpile.py).
 
 Every number of the geometry and the heads comes from the `SandPileScene` (no copies); what is the
 DEM's own is the grain size, the slice width and the contact law. The pile is fully saturated and
@@ -22,7 +28,6 @@ roll freely are weaker than a 30° slope of real sand (doc/dem.md, the triaxial 
 import dataclasses
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
 import yade.wrapper as w
@@ -31,7 +36,7 @@ from yade import O, Vector3
 from .dem import XMAX, XMIN, ZMAX, _require, contact_loop, contact_material, switch_flow_on
 
 
-@dataclass
+@dataclasses.dataclass
 class PileSample:
     """A carved, settled sphere pile in a slice of the flume, ready for the head rise."""
     wall_ids: list           # body ids of the walls, xMin..zMax (xMin: inflow, xMax: outflow, zMax: the lid)
@@ -62,34 +67,36 @@ def _engines(gravity, damping):
             w.FlowEngine(dead=True, label="flow"), w.NewtonIntegrator(damping=damping, gravity=gravity, label="newton")]
 
 
-def _settle(max_steps, unbalanced=0.01, speed=1e-4, grain_ids=None):
-    """Step until the unbalanced force is below `unbalanced` and every free grain is slower than
-    `speed` [m s⁻¹]. Returns the steps taken."""
+def _settle(max_steps, grain_ids, unbalanced=0.01, speed=1e-4):
+    """Step until the unbalanced force is below `unbalanced` and every one of `grain_ids` is slower
+    than `speed` [m s⁻¹]. Returns the steps taken."""
     from yade import utils
     steps = 0
     while steps < max_steps:
         O.run(500, True)
         steps += 500
-        fastest = max((O.bodies[int(i)].state.vel.norm() for i in grain_ids), default=0.0) if grain_ids is not None else 0.0
+        fastest = max((O.bodies[int(i)].state.vel.norm() for i in grain_ids), default=0.0)
         if utils.unbalancedForce() < unbalanced and fastest < speed:
             return steps
     raise RuntimeError("the pile did not come to rest within %d steps (unbalanced force %.3g)" % (max_steps, utils.unbalancedForce()))
 
 
-def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.03, friction_angle=math.radians(30), rolling_resistance=0.3,
+def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.03, friction_angle=math.radians(30), rolling_resistance=0.05,
           young=2e6, contact_poisson=0.5, wall_friction_angle=0.0, lid_friction_angle=None, lid_pressure=None, seed=1, max_steps=200000):
     """Reset the scene and build the pile of `scene` (a yade_mpm.sandpile.SandPileScene with still
     water: PFV models a fully saturated pile) in a slice `slice_width` [m] wide: spheres of mean
     `grain_radius` [m] (± `radius_spread`, relative) rained into the box between the inflow wall
     and a gate at the toe, under full gravity with 1° contact friction (a dense packing); carved to
-    the scene's surface (a grain stays if its centre lies below the slope, or its top below the
+    the scene's surface (a grain stays if its centre lies below the slope and its top below the
     crest); the grains within 1.7 radii of the base frozen (the rough base the MPM's frictional base
-    stands for); the gate moved to the flume's end and the lid lowered onto the crest; then the
-    contact `friction_angle` and `rolling_resistance` (etaRoll [-], the rolling moment's cap in units
-    of r Fn) switched on and the pile settled under buoyant gravity. `young` [Pa] and
-    `contact_poisson` [-] are the contact stiffness parameters; `wall_friction_angle` [rad] that of
-    the lid and the front and rear walls; `gravity` the scene's gravity vector [m s⁻²] (z down).
-    Returns a PileSample."""
+    stands for); the gate removed; the contact `friction_angle` and `rolling_resistance` (etaRoll
+    [-], the rolling and twisting moments' cap in units of r Fn; 0.05 gives these grains the MPM
+    sand's 36° drained peak, doc/dem.md) switched on and the pile settled under buoyant gravity with
+    the lid resting on the crest under `lid_pressure` [Pa] (default the weight of one grain radius of
+    buoyant sand); then the lid is held where it rests. `young` [Pa] and `contact_poisson` [-] are
+    the contact stiffness parameters; `wall_friction_angle` [rad] that of the flume's walls (front,
+    rear, inflow, outflow; default smooth), `lid_friction_angle` [rad] the lid's (default the
+    grains'); `gravity` the scene's gravity vector [m s⁻²] (z down). Returns a PileSample."""
     from yade import pack, utils
     scene.validate()
     _require("scene.still_water_level", scene.still_water_level, scene.still_water_level is not None,
@@ -102,6 +109,8 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
     _require("friction_angle", friction_angle, 0 < friction_angle < math.pi / 2, "(0, π/2) rad")
     _require("rolling_resistance", rolling_resistance, rolling_resistance >= 0, "[0, inf)")
     _require("wall_friction_angle", wall_friction_angle, 0 <= wall_friction_angle < math.pi / 2, "[0, π/2) rad")
+    _require("lid_friction_angle", lid_friction_angle, lid_friction_angle is None or 0 <= lid_friction_angle < math.pi / 2, "None or [0, π/2) rad")
+    _require("lid_pressure", lid_pressure, lid_pressure is None or lid_pressure > 0, "None or (0, inf) Pa")
     clock = time.time()
     O.reset()
     g = float(np.linalg.norm(gravity))
@@ -116,16 +125,17 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
                                                     material=walls_mat)))
     gate = O.bodies.append(utils.box(Vector3(toe, 0.5 * slice_width, 0.5 * top), Vector3(0, 0.5 * slice_width, 0.5 * top), fixed=True,
                                      material=walls_mat))
-    solid_fraction = 0.62
+    # enough grains to fill 1.2 pile heights behind the gate at a dense packing's solid fraction
+    # (≈ 0.62), as a cloud three pile heights tall (loose enough for makeCloud to place them)
     grain_volume = 4 / 3 * math.pi * grain_radius ** 3 * (1 + radius_spread ** 2)
-    count = int(1.2 * height * toe * slice_width * solid_fraction / grain_volume)
+    count = int(1.2 * height * toe * slice_width * 0.62 / grain_volume)
     cloud = pack.SpherePack()
     cloud.makeCloud(Vector3(0, 0, 0), Vector3(toe, slice_width, top), grain_radius, radius_spread, count, False, 0.95, seed=seed)
     O.bodies.append([utils.sphere(c, r, material=grains_mat) for c, r in cloud])
     O.engines = _engines(Vector3(0, 0, -g), damping=0.4)
     O.dt = 0.5 * utils.PWaveTimeStep()
     grains = [b.id for b in O.bodies if isinstance(b.shape, w.Sphere)]
-    deposition_steps = _settle(max_steps, grain_ids=grains, unbalanced=0.1, speed=2e-2)
+    deposition_steps = _settle(max_steps, grains, unbalanced=0.1, speed=2e-2)
     # carve to the scene's surface
     for i in grains:
         b = O.bodies[i]
@@ -137,7 +147,8 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
     for i in base:
         s = O.bodies[i].state
         s.blockedDOFs, s.vel, s.angVel = "xyzXYZ", Vector3(0, 0, 0), Vector3(0, 0, 0)
-    free = [i for i in grains if i not in set(base)]
+    base_set = set(base)
+    free = [i for i in grains if i not in base_set]
     # the gate opens, the lid comes down onto the crest
     O.bodies.erase(gate)
     lid = O.bodies[wall_ids[ZMAX]]
@@ -150,15 +161,15 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
     O.materials[grains_mat].momentRotationLaw = rolling_resistance > 0
     O.interactions.clear()
     buoyant = g * (1 - scene.water_density / scene.grain_density)
-    O.engines[-1].gravity = Vector3(0, 0, -buoyant)
-    O.engines[-1].damping = 0.2
+    newton = O.engines[-1]
+    newton.gravity, newton.damping = Vector3(0, 0, -buoyant), 0.2
     # the lid rests on the crest with the weight of one grain radius of buoyant sand by default: a lid
     # held at a fixed height leaves a gap over the settled crest, a channel the seepage sweeps the
     # top grains along
     lid_pressure = (scene.grain_density - scene.water_density) * (1 - scene.porosity) * g * grain_radius if lid_pressure is None else lid_pressure
     lid.state.blockedDOFs = "xyXYZ"
     lid.state.mass = lid_pressure * scene.crest_length * slice_width / buoyant
-    settling_steps = _settle(max_steps, grain_ids=free, speed=1e-4)
+    settling_steps = _settle(max_steps, free)
     # then held where it rests: it holds heave (the excess pressure under it would lift a weight)
     lid.state.blockedDOFs, lid.state.vel = "xyzXYZ", Vector3(0, 0, 0)
     pile = PileSample(wall_ids=wall_ids, grain_ids=np.array(free), base_ids=np.array(base), start_positions=None, slice_width=slice_width,
