@@ -25,12 +25,13 @@ parser.add_argument("--grain-radius", type=float, help="mean grain radius [m] (d
 parser.add_argument("--slice-width", type=float, default=0.03, help="width of the flume slice [m] (default 0.03)")
 parser.add_argument("--rolling-resistance", type=float, default=0.05,
                     help="contact etaRoll [-] (default 0.05: a drained triaxial peak of about 36°, the MPM sand's φ)")
+parser.add_argument("--grain-lid", action="store_true", help="freeze the crest's top grains under the lid (a lid of grains)")
 parser.add_argument("--out", help="output directory (default: out or out-quick beside this script)")
 args = parser.parse_args()
 out = args.out or os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "out-quick" if args.quick else "out")
 GRAVITY = (0.0, 0.0, -9.81)  # [m s⁻²]
 s = dem_pile.run_case(out, GRAVITY, quick=args.quick, control=args.control, ramp_time=args.ramp_time, grain_radius=args.grain_radius,
-                      slice_width=args.slice_width, rolling_resistance=args.rolling_resistance)
+                      slice_width=args.slice_width, rolling_resistance=args.rolling_resistance, grain_lid=args.grain_lid)
 
 
 def metres(value):

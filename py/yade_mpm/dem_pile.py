@@ -41,7 +41,7 @@ class PileSample:
     """A carved, settled sphere pile in a slice of the flume, ready for the head rise."""
     wall_ids: list           # body ids of the walls, xMin..zMax (xMin: inflow, xMax: outflow, zMax: the lid)
     grain_ids: np.ndarray    # ids of the free grains
-    base_ids: np.ndarray     # ids of the frozen grains of the rough base
+    base_ids: np.ndarray     # ids of the frozen grains: the rough base (and the lid of grains, if any)
     start_positions: np.ndarray  # free grains' centres when the head rise starts [m], rows of grain_ids
     slice_width: float       # [m] along y
     grain_radius: float      # mean radius [m]
@@ -82,7 +82,7 @@ def _settle(max_steps, grain_ids, unbalanced=0.01, speed=1e-4):
 
 
 def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.03, friction_angle=math.radians(30), rolling_resistance=0.05,
-          young=2e6, contact_poisson=0.5, wall_friction_angle=0.0, lid_friction_angle=None, lid_pressure=None, seed=1, max_steps=200000):
+          young=2e6, contact_poisson=0.5, wall_friction_angle=0.0, lid_friction_angle=None, lid_pressure=None, grain_lid=False, seed=1, max_steps=200000):
     """Reset the scene and build the pile of `scene` (a yade_mpm.sandpile.SandPileScene with still
     water: PFV models a fully saturated pile) in a slice `slice_width` [m] wide: spheres of mean
     `grain_radius` [m] (± `radius_spread`, relative) rained into the box between the inflow wall
@@ -96,7 +96,9 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
     buoyant sand); then the lid is held where it rests. `young` [Pa] and `contact_poisson` [-] are
     the contact stiffness parameters; `wall_friction_angle` [rad] that of the flume's walls (front,
     rear, inflow, outflow; default smooth), `lid_friction_angle` [rad] the lid's (default the
-    grains'); `gravity` the scene's gravity vector [m s⁻²] (z down). Returns a PileSample."""
+    grains'); `grain_lid`: also freeze the crest's grains within two radii of the lid (a lid of
+    grains: a flat wall leaves a more open grain layer along it, a channel the seepage follows);
+    `gravity` the scene's gravity vector [m s⁻²] (z down). Returns a PileSample."""
     from yade import pack, utils
     scene.validate()
     _require("scene.still_water_level", scene.still_water_level, scene.still_water_level is not None,
@@ -172,6 +174,14 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
     settling_steps = _settle(max_steps, free)
     # then held where it rests: it holds heave (the excess pressure under it would lift a weight)
     lid.state.blockedDOFs, lid.state.vel = "xyzXYZ", Vector3(0, 0, 0)
+    if grain_lid:
+        crest_top = [i for i in free if O.bodies[i].state.pos[0] <= scene.crest_length
+                     and O.bodies[i].state.pos[2] + O.bodies[i].shape.radius > lid.state.pos[2] - 2 * grain_radius]
+        for i in crest_top:
+            st = O.bodies[i].state
+            st.blockedDOFs, st.vel, st.angVel = "xyzXYZ", Vector3(0, 0, 0), Vector3(0, 0, 0)
+        base, frozen = base + crest_top, set(crest_top)
+        free = [i for i in free if i not in frozen]
     pile = PileSample(wall_ids=wall_ids, grain_ids=np.array(free), base_ids=np.array(base), start_positions=None, slice_width=slice_width,
                       grain_radius=grain_radius, buoyant_gravity=buoyant, crest_height=lid.state.pos[2], lid_pressure=lid_pressure,
                       build_steps=deposition_steps + settling_steps, build_wall_time=0.0)
@@ -369,7 +379,7 @@ DEFAULT_CASE = {"grain_radius": 0.004, "ramp_time": 4.0}  # about 1400 grains
 
 
 def run_case(out_dir, gravity, quick=False, control=False, ramp_time=None, grain_radius=None, slice_width=0.03, rolling_resistance=0.05,
-             young=2e6, contact_friction_angle=math.radians(30), scene=None):
+             young=2e6, contact_friction_angle=math.radians(30), scene=None, grain_lid=False):
     """The whole DEM pile case, as examples/dem/sandpile.py and `python3 -m yade_mpm.compare sandpile`
     run it: the MPM's submerged, lidded pile (`scene`, default yade_mpm.sandpile.SUBMERGED with the
     crest lid) with its head history compressed to a rise of `ramp_time` [s] (settling 5% and holding
@@ -396,18 +406,29 @@ def run_case(out_dir, gravity, quick=False, control=False, ramp_time=None, grain
                                     grain_density=scene.grain_density, final_strain=0.1, rolling_resistance=rolling_resistance)
     strength = calibrate.strength_from_triaxial(triaxial)
     pile = build(scene, gravity, grain_radius=radius, slice_width=slice_width, friction_angle=contact_friction_angle,
-                 rolling_resistance=rolling_resistance, young=young)
+                 rolling_resistance=rolling_resistance, young=young, grain_lid=grain_lid)
     lem = {"heads_m": [], "factors": []}
 
     def bishop(record, flow):
         if len(record["time"]) % 2 == 0:
-            circle = limit_equilibrium(pile, scene, gravity, flow, strength["frictionAngle"], strength["dilatancyAngle"])
+            try:
+                factor = limit_equilibrium(pile, scene, gravity, flow, strength["frictionAngle"], strength["dilatancyAngle"]).factor
+            except ValueError:  # no circle of the search qualifies (a slid, reshaped slope): no factor at this record
+                factor = None
             lem["heads_m"].append(record["head"][-1])
-            lem["factors"].append(circle.factor)
+            lem["factors"].append(factor)
 
-    record = raise_head(pile, scene, gravity, record_interval=ramp / 40, on_record=bishop)
+    def progress(record, flow):
+        bishop(record, flow)
+        if len(record["time"]) % 10 == 0:
+            print("dem_pile: t = %.3f s, head %.4f m, face %.2e m, toe %.2e m, Bishop F %s (%.0f s)"
+                  % (record["time"][-1], record["head"][-1], record["face_displacement"][-1], record["toe_displacement"][-1],
+                     lem["factors"][-1] if lem["factors"] else None, time.time() - clock), flush=True)
+
+    clock = time.time()
+    record = raise_head(pile, scene, gravity, record_interval=ramp / 40, on_record=progress)
     result = summary(pile, scene, record)
-    result.update(control=control, rolling_resistance=rolling_resistance, contact_friction_angle_deg=math.degrees(contact_friction_angle),
+    result.update(control=control, grain_lid=grain_lid, rolling_resistance=rolling_resistance, contact_friction_angle_deg=math.degrees(contact_friction_angle),
                   contact_young_Pa=young, gravity_m_per_s2=list(gravity), probe_points=scene.probe_points(slice_width),
                   triaxial={"grains": 300, "confinement_Pa": confinement, "peak_friction_angle_deg": math.degrees(strength["frictionAngle"]),
                             "residual_friction_angle_deg": math.degrees(strength["residualFrictionAngle"]),

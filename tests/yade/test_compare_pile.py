@@ -70,9 +70,10 @@ def test_the_comparison_reports_its_inputs(runs):
     result = compare_pile.compare(runs / "mpm", runs / "dem")
     mpm, dem = result["mpm"], result["dem"]
     assert (mpm["onset_head_m"], mpm["lem_onset_head_m"], mpm["lem_one_cell_onset_head_m"]) == (0.205, 0.215, 0.17)
+    assert mpm["wall_s_per_cm_of_rise"] == pytest.approx(410.0 / 8, rel=1e-9)  # the head rose 8 cm by 41 s
     assert (dem["onset_head_m"], dem["lem_onset_head_m"]) == (0.213, 0.21)
-    # the probe heads sit below both onsets: fractions of the smaller onset rise (0.055 m)
-    assert result["probe_heads_m"] == pytest.approx([STILL + f * 0.055 for f in compare_pile.FRACTIONS], rel=1e-12)
+    # the probe heads: fractions of the larger onset rise (0.063 m)
+    assert result["probe_heads_m"] == pytest.approx([STILL + f * 0.063 for f in compare_pile.FRACTIONS], rel=1e-12)
     for side in (mpm, dem):
         for name, fraction in zip(PROBES, FRACTIONS):
             assert side["probe_fractions"][name] == pytest.approx([fraction] * 3, rel=1e-9)
@@ -91,6 +92,7 @@ def test_the_command_writes_the_report_and_refuses_a_scene_pfv_cannot_model(runs
     assert done.returncode == 0, done.stderr[-2000:]
     text = (out / "report.md").read_text()
     assert "| onset head (slope face's compliance) [m] | 0.205 | 0.213 |" in text
+    assert "| Bishop on the run's own pressure field, F = 1 at head [m] | 0.170 (slides ≥ 1 cell), 0.215 (≥ 3 cells) | 0.210" in text
     assert json.load(open(out / "report.json"))["dem"]["onset_head_m"] == 0.213
     assert (out / "sandpile.png").stat().st_size > 10000
     summary = json.load(open(runs / "mpm" / "summary.json"))
