@@ -105,7 +105,7 @@ def falls_below(loads, values, level=1.0):
     return None
 
 
-def sliding_surface(start_positions, moving, bin_width, ground_height, offset=0.0, x_max=None):
+def sliding_surface(start_positions, moving, bin_width, ground_height, offset=0.0):
     """The base of a sliding mass in the undeformed configuration: in each column of `bin_width` [m]
     along x, the lowest start position (x, z) [m] of the bodies flagged `moving`, lowered by `offset`
     [m] (half a point spacing, or a grain radius). `ground_height(x)` is the ground's height before
@@ -115,9 +115,8 @@ def sliding_surface(start_positions, moving, bin_width, ground_height, offset=0.
     if not moving.any():
         return None
     x0, z0 = start[:, 0], start[:, 2]
-    top = x0.max() if x_max is None else x_max
     xs, zs = [], []
-    for lo in np.arange(x0.min(), top + bin_width, bin_width):
+    for lo in np.arange(x0.min(), x0.max() + bin_width, bin_width):
         column = moving & (x0 >= lo) & (x0 < lo + bin_width)
         if column.any():
             xs.append(lo + 0.5 * bin_width)

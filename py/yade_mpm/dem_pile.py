@@ -191,9 +191,10 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
 
 
 def _region(pile, scene, which):
-    """Rows of pile.grain_ids in the toe region (within four radii of the toe along the base) or on
-    the lower slope face (within four radii of the downstream surface, below mid-height) at the start:
-    the same regions as the MPM example's, measured in grains instead of cells."""
+    """Rows of pile.grain_ids in the toe region (within eight radii upstream of the toe and four above
+    the base) or on the lower slope face (within four radii of the downstream surface, below
+    mid-height) at the start: the MPM example's regions (two cells from the toe and the base, two
+    cells under the surface), with two grain diameters for a cell."""
     x, z = pile.start_positions[:, 0], pile.start_positions[:, 2]
     reach = 4 * pile.grain_radius
     if which == "toe":
@@ -324,7 +325,7 @@ def summary(pile, scene, record):
         "sliding_surface": sliding,
         "inflow_before_onset_m3_per_s": inflow, "outflow_before_onset_m3_per_s": outflow,
         "flux_mismatch_before_onset": abs(inflow - outflow) / max(abs(inflow), 1e-300),
-        "time_step_s": record["time_step"], "steps": record["steps"], "build_wall_s": pile.build_wall_time, "run_wall_s": record["wall_time"],
+        "time_step_s": record["time_step"], "steps": record["steps"], "build_steps": pile.build_steps, "build_wall_s": pile.build_wall_time, "run_wall_s": record["wall_time"],
         "wall_s_per_simulated_s": record["wall_time"] / record["time"][-1],
     }
 
