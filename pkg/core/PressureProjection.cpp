@@ -18,6 +18,57 @@ namespace {
 
 	// Stencil slot of the offset (a, b, c) ∈ [−2, 2]³ between two nodes sharing a point.
 	inline int offsetSlot(int a, int b, int c) { return (a + 2) + 5 * ((b + 2) + 5 * (c + 2)); }
+
+	constexpr int centreSlot = 62; // offsetSlot(0, 0, 0)
+	// Slot in a stored row (PressureSystem::rows) of an offset ≥ 0 lexicographically.
+	inline int upperSlot(int a, int b, int c) { return offsetSlot(a, b, c) - centreSlot; }
+
+	// The point's share of K (eqs. 8.3, 8.6) for every pair of its stencil nodes J, K:
+	// storage S_J S_K + Σ_d conductance_d ∂_d S_J ∂_d S_K. K is symmetric, so only the pairs whose
+	// offset K − J is lexicographically ≥ 0 in (z, y, x) are stored (upperSlot), 378 of the
+	// 729 of a GIMP stencil; buildPressureMatrix reads the other half from the neighbour's row. The
+	// shape functions are tensor products, S = X(x) Y(y) Z(z), so the pair term factors into per-axis
+	// products of the 1D weights: Xv Yv Zv storage + Xg Yv Zv cx + Xv Yg Zv cy + Xv Yv Zg cz = Xv A + Xg B
+	// with A, B per (y, z) pair. Same result as summing the 3D products pair by pair to round-off
+	// (tests/core/test_pressure_projection.cpp).
+	template <int S>
+	inline void addPairTerms(const GridGeometry& grid, const Weights1D (&w)[3], const int (&node)[3][S], Real storage, const Vec3& conductance,
+	                         const PressureSystem& system, Real* rows)
+	{
+		Real xv[S][S], xg[S][S], yv[S][S], yg[S][S], zv[S][S], zg[S][S];
+		for (int i = 0; i < S; ++i)
+			for (int j = 0; j < S; ++j) {
+				xv[i][j] = w[0].value[i] * w[0].value[j], xg[i][j] = w[0].gradient[i] * w[0].gradient[j];
+				yv[i][j] = w[1].value[i] * w[1].value[j], yg[i][j] = w[1].gradient[i] * w[1].gradient[j];
+				zv[i][j] = w[2].value[i] * w[2].value[j], zg[i][j] = w[2].gradient[i] * w[2].gradient[j];
+			}
+		for (int c = 0; c < S; ++c)
+			for (int b = 0; b < S; ++b) {
+				Real A[S][S], B[S][S]; // per (cc, bb): the coefficients of Xv and Xg
+				for (int cc = c; cc < S; ++cc)
+					for (int bb = 0; bb < S; ++bb) {
+						const Real vv = yv[b][bb] * zv[c][cc];
+						A[cc][bb]     = storage * vv + conductance[1] * yg[b][bb] * zv[c][cc] + conductance[2] * yv[b][bb] * zg[c][cc];
+						B[cc][bb]     = conductance[0] * vv;
+					}
+				for (int a = 0; a < S; ++a) {
+					// a node where S_J and ∇S_J vanish gets no row (it may have no pressure node)
+					const Real vx = w[0].value[a], vy = w[1].value[b], vz = w[2].value[c];
+					if (vx * vy * vz == 0 && w[0].gradient[a] * vy * vz == 0 && vx * w[1].gradient[b] * vz == 0 && vx * vy * w[2].gradient[c] == 0) continue;
+					Real* r = rows + static_cast<std::size_t>(system.row[grid.index(node[0][a], node[1][b], node[2][c])]) * PressureSystem::rowStride;
+					for (int aa = a; aa < S; ++aa) r[upperSlot(aa - a, 0, 0)] += xv[a][aa] * A[c][b] + xg[a][aa] * B[c][b]; // same y and z: x ≥ 0
+					for (int bb = b + 1; bb < S; ++bb) {
+						Real* slot = r + upperSlot(-a, bb - b, 0);
+						for (int aa = 0; aa < S; ++aa) slot[aa] += xv[a][aa] * A[c][bb] + xg[a][aa] * B[c][bb];
+					}
+					for (int cc = c + 1; cc < S; ++cc)
+						for (int bb = 0; bb < S; ++bb) {
+							Real* slot = r + upperSlot(-a, bb - b, cc - c);
+							for (int aa = 0; aa < S; ++aa) slot[aa] += xv[a][aa] * A[cc][bb] + xg[a][aa] * B[cc][bb];
+						}
+				}
+			}
+	}
 } // namespace
 
 namespace stages {
@@ -174,25 +225,14 @@ namespace stages {
 				const Real storage    = V * n * invKw / dt; // C/Δt (eq. 8.3), consistent: Σ V S_J S_K n/(Kw Δt)
 				const Vec3 conductance = dt * V * lambda;    // Δt L (eq. 8.6), per axis
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n
-				Vec3 flux[S][S][S]; // Δt V Λ ∇S_K: the column factor of every pair, once per point
-				for (int c = 0; c < S; ++c)
-					for (int b = 0; b < S; ++b)
-						for (int a = 0; a < S; ++a) flux[c][b][a] = conductance.cwiseProduct(dN[c][b][a]);
 				for (int c = 0; c < S; ++c)
 					for (int b = 0; b < S; ++b)
 						for (int a = 0; a < S; ++a) {
-							const Real Nj = N[c][b][a];
-							if (Nj == 0 && dN[c][b][a].isZero()) continue;
-							Real* r = rows + static_cast<std::size_t>(system.row[grid.index(node[0][a], node[1][b], node[2][c])]) * PressureSystem::rowStride;
-							r[PressureSystem::rhsSlot] += Nj * (stored - V * divergence) + V * relativeFlux.dot(dN[c][b][a]);
-							const Real storageJ = storage * Nj;
-							const Vec3 gradJ    = dN[c][b][a];
-							for (int cc = 0; cc < S; ++cc)
-								for (int bb = 0; bb < S; ++bb) {
-									Real* slot = r + offsetSlot(-a, bb - b, cc - c);
-									for (int aa = 0; aa < S; ++aa) slot[aa] += storageJ * N[cc][bb][aa] + gradJ.dot(flux[cc][bb][aa]);
-								}
+							if (N[c][b][a] == 0 && dN[c][b][a].isZero()) continue;
+							rows[static_cast<std::size_t>(system.row[grid.index(node[0][a], node[1][b], node[2][c])]) * PressureSystem::rowStride +
+							     PressureSystem::rhsSlot] += N[c][b][a] * (stored - V * divergence) + V * relativeFlux.dot(dN[c][b][a]);
 						}
+				addPairTerms<S>(grid, w, node, storage, conductance, system, rows);
 			});
 		}
 		// the solid's share of the volume balance, (1 − n)∇·vs − vs·∇n, at the solid points (eq. 8.2):
@@ -260,70 +300,96 @@ namespace stages {
 		// the others and would ruin the conditioning. Such a node, and one no point's gradient reaches
 		// that stores nothing (incompressible water), is held at p = 0.
 		Real largestDiagonal = 0;
-		for (std::size_t r = 0; r < active; ++r) largestDiagonal = std::max(largestDiagonal, system.rows[r * PressureSystem::rowStride + offsetSlot(0, 0, 0)]);
+		for (std::size_t r = 0; r < active; ++r) largestDiagonal = std::max(largestDiagonal, system.rows[r * PressureSystem::rowStride + upperSlot(0, 0, 0)]);
 		const Real negligible = std::numeric_limits<Real>::epsilon() * largestDiagonal;
 		for (std::size_t r = 0; r < active; ++r)
-			if (!system.fixed[r] && !(system.rows[r * PressureSystem::rowStride + offsetSlot(0, 0, 0)] > negligible)) system.fixed[r] = 1, system.fixedValue[r] = 0;
+			if (!system.fixed[r] && !(system.rows[r * PressureSystem::rowStride + upperSlot(0, 0, 0)] > negligible)) system.fixed[r] = 1, system.fixedValue[r] = 0;
 		system.unknown.assign(active, -1);
 		int n = 0;
 		for (std::size_t r = 0; r < active; ++r)
 			if (!system.fixed[r]) system.unknown[r] = n++;
 		system.rhs.resize(n);
-		// CSR of the free rows: the columns of a row sorted and merged (on a periodic axis of 3 cells
-		// two offsets reach one node), the prescribed columns moved to the right-hand side
-		struct Entry {
-			int  column;
-			Real value;
-		};
-		using Entries = std::array<Entry, PressureSystem::offsets>;
-		auto collect = [&](std::size_t r, Entries& entries, Real& rhs) {
+		// CSR of the free rows, the prescribed columns moved to the right-hand side. Each stored pair
+		// (r, J) of the upper half gives K_rJ to row r and K_Jr = K_rJ to row J. Rows are visited in
+		// grid order, so row u receives its lower entries (from earlier rows) and then its own upper
+		// ones in column order; only a periodic axis that wrapped breaks the order, and on one of 3
+		// cells two offsets reach the same node: such rows are sorted and merged afterwards.
+		using Pair         = PressureSystem::FreePair;
+		std::vector<Pair>& pairs = system.pairScratch;
+		pairs.clear();
+		for (int u = 0; u < n; ++u) system.rhs[u] = 0;
+		for (std::size_t r = 0; r < active; ++r)
+			if (!system.fixed[r]) system.rhs[system.unknown[r]] = system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
+		std::vector<int>& count = system.rowCount;
+		count.assign(n + 1, 0);
+		for (std::size_t r = 0; r < active; ++r) {
 			const Real*              k   = system.rows.data() + r * PressureSystem::rowStride;
 			const std::array<int, 3> idx = grid.indices(system.node[r]);
-			int                      used = 0;
-			rhs                          = k[PressureSystem::rhsSlot];
-			for (int o = 0; o < PressureSystem::offsets; ++o) {
-				if (k[o] == 0) continue; // a non-zero coefficient joins two nodes of one stencil: both on the grid
-				const int         a = o % 5 - 2, b = (o / 5) % 5 - 2, c = o / 25 - 2;
-				const std::size_t J = grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c));
-				const int         col = system.row[J];
-				if (system.fixed[col]) rhs -= k[o] * system.fixedValue[col];
-				else entries[used++] = Entry { system.unknown[col], k[o] };
+			const bool               rowFixed = system.fixed[r];
+			for (int o = centreSlot; o < PressureSystem::offsets; ++o) {
+				const Real value = k[o - centreSlot];
+				if (value == 0) continue; // a non-zero coefficient joins two nodes of one stencil: both on the grid
+				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, c = o / 25 - 2;
+				const int J = system.row[grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c))];
+				const bool columnFixed = system.fixed[J];
+				if (rowFixed && columnFixed) continue;
+				if (columnFixed) system.rhs[system.unknown[r]] -= value * system.fixedValue[J];
+				else if (rowFixed) system.rhs[system.unknown[J]] -= value * system.fixedValue[r];
+				else {
+					const int ur = system.unknown[r], uJ = system.unknown[J];
+					pairs.push_back(Pair { ur, uJ, value });
+					++count[ur + 1];
+					if (uJ != ur) ++count[uJ + 1];
+				}
 			}
-			// the offsets run in grid order, so the columns come sorted unless a periodic axis wrapped
-			if (!std::is_sorted(entries.begin(), entries.begin() + used, [](const Entry& x, const Entry& y) { return x.column < y.column; }))
-				std::sort(entries.begin(), entries.begin() + used, [](const Entry& x, const Entry& y) { return x.column < y.column; });
-			int merged = 0;
-			for (int e = 0; e < used; ++e) {
-				if (merged > 0 && entries[merged - 1].column == entries[e].column) entries[merged - 1].value += entries[e].value;
-				else entries[merged++] = entries[e];
-			}
-			return merged;
-		};
-		std::vector<int> start(n + 1, 0);
-#pragma omp parallel for schedule(static) if(active > parallelThreshold)
-		for (std::size_t r = 0; r < active; ++r) {
-			if (system.fixed[r]) continue;
-			Entries entries;
-			Real    rhs;
-			start[system.unknown[r] + 1] = collect(r, entries, rhs);
 		}
-		for (int i = 0; i < n; ++i) start[i + 1] += start[i];
+		for (int i = 0; i < n; ++i) count[i + 1] += count[i];
+		std::vector<int>&  column = system.columnScratch;
+		std::vector<Real>& value  = system.valueScratch;
+		column.resize(count[n]);
+		value.resize(count[n]);
+		std::vector<int>& cursor = system.cursorScratch;
+		cursor.assign(count.begin(), count.end() - 1);
+		for (const Pair& e : pairs) {
+			column[cursor[e.row]] = e.column, value[cursor[e.row]++] = e.value;
+			if (e.column != e.row) column[cursor[e.column]] = e.row, value[cursor[e.column]++] = e.value;
+		}
+		// sort (where a periodic axis wrapped) and merge each row in place; `merged` keeps the new lengths
+		std::vector<int>& merged = system.cursorScratch;
+#pragma omp parallel for schedule(static) if(n > static_cast<int>(parallelThreshold))
+		for (int u = 0; u < n; ++u) {
+			const int first = count[u], last = count[u + 1];
+			bool      sorted = true;
+			for (int e = first + 1; e < last && sorted; ++e) sorted = column[e - 1] < column[e];
+			if (sorted) {
+				merged[u] = last - first;
+				continue;
+			}
+			std::vector<std::pair<int, Real>> row;
+			for (int e = first; e < last; ++e) row.emplace_back(column[e], value[e]);
+			std::sort(row.begin(), row.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+			int m = 0;
+			for (const auto& [col, v] : row) {
+				if (m > 0 && column[first + m - 1] == col) value[first + m - 1] += v;
+				else column[first + m] = col, value[first + m] = v, ++m;
+			}
+			merged[u] = m;
+		}
 		Eigen::SparseMatrix<Real, Eigen::RowMajor>& A = system.matrix;
 		A.resize(n, n);
-		A.resizeNonZeros(start[n]);
-		std::copy(start.begin(), start.end(), A.outerIndexPtr());
+		int nonZeros = 0;
+		for (int u = 0; u < n; ++u) nonZeros += merged[u];
+		A.resizeNonZeros(nonZeros);
+		A.outerIndexPtr()[0] = 0;
+		for (int u = 0; u < n; ++u) A.outerIndexPtr()[u + 1] = A.outerIndexPtr()[u] + merged[u];
 		Real diagonalSum = 0;
-#pragma omp parallel for schedule(static) reduction(+ : diagonalSum) if(active > parallelThreshold)
-		for (std::size_t r = 0; r < active; ++r) {
-			if (system.fixed[r]) continue;
-			Entries   entries;
-			Real      rhs;
-			const int count = collect(r, entries, rhs), u = system.unknown[r];
-			system.rhs[u]   = rhs;
-			for (int e = 0; e < count; ++e) {
-				A.innerIndexPtr()[start[u] + e] = entries[e].column;
-				A.valuePtr()[start[u] + e]      = entries[e].value;
-				if (entries[e].column == u) diagonalSum += entries[e].value;
+#pragma omp parallel for schedule(static) reduction(+ : diagonalSum) if(n > static_cast<int>(parallelThreshold))
+		for (int u = 0; u < n; ++u) {
+			const int from = count[u], to = A.outerIndexPtr()[u];
+			for (int e = 0; e < merged[u]; ++e) {
+				A.innerIndexPtr()[to + e] = column[from + e];
+				A.valuePtr()[to + e]      = value[from + e];
+				if (column[from + e] == u) diagonalSum += value[from + e];
 			}
 		}
 		system.meanDiagonal = n > 0 ? diagonalSum / n : 0;

@@ -50,17 +50,20 @@ struct ProjectionForms {
 
 // The grid-node system of eq. 8.7 and its scratch, reused from step to step.
 struct PressureSystem {
-	// One row of K in stencil form: offsets (−2..2)³ between two nodes that share a point, then b_J.
-	static constexpr int offsets   = 125;
-	static constexpr int rowStride = offsets + 1;
-	static constexpr int rhsSlot   = offsets;
+	// One row of K in stencil form: of the offsets (−2..2)³ between two nodes that share a point, the
+	// 63 that are ≥ 0 lexicographically in (z, y, x) (K is symmetric: the others are in the
+	// neighbours' rows), then b_J; 64 values, eight cache lines.
+	static constexpr int offsets       = 125;
+	static constexpr int storedOffsets = 63;
+	static constexpr int rowStride     = storedOffsets + 1;
+	static constexpr int rhsSlot       = storedOffsets;
 
 	std::vector<int>         row;            // per grid node: its pressure node, −1 where no water point reaches
 	std::vector<std::size_t> node;           // per pressure node: the grid node
 	std::vector<char>        fixed;          // per pressure node: the pressure is prescribed
 	std::vector<Real>        fixedValue;     // per pressure node: prescribed p^{n+1} where fixed [Pa]
 	std::vector<int>         unknown;        // per pressure node: its index among the unknowns, −1 where fixed
-	std::vector<Real>        rows;           // per pressure node: rowStride coefficients (K [m³ s⁻¹ Pa⁻¹], then b [m³ s⁻¹])
+	std::vector<Real>        rows;           // per pressure node: rowStride values (K's upper half [m³ s⁻¹ Pa⁻¹], then b [m³ s⁻¹])
 	std::vector<std::vector<Real>> rowBuffers; // per extra thread
 	std::vector<Real>        nodalPressure;   // per grid node: p^{n+1}, 0 off the pressure nodes [Pa]
 	std::vector<Vec3>        mobility;        // per grid node and axis: λ of eq. 8.5 with the walls' holds [m³ kg⁻¹]
@@ -71,6 +74,13 @@ struct PressureSystem {
 	std::vector<PressureForceNode>              forces;
 	std::vector<std::vector<PressureForceNode>> forceBuffers;
 	Eigen::SparseMatrix<Real, Eigen::RowMajor> matrix;
+	struct FreePair {
+		int  row, column; // unknowns of an upper-half pair of K
+		Real value;
+	};
+	std::vector<FreePair> pairScratch;                              // buildPressureMatrix's scratch, kept from step to step
+	std::vector<int>      rowCount, cursorScratch, columnScratch; // (same)
+	std::vector<Real>     valueScratch;                           // (same)
 	Eigen::Matrix<Real, Eigen::Dynamic, 1>     rhs, solution, previousSolution;
 	std::vector<std::size_t>                   previousNode; // grid node of each entry of previousSolution (warm start)
 	Real                                       meanDiagonal = 0; // mean K_JJ of the free rows [m³ s⁻¹ Pa⁻¹]

@@ -1,12 +1,16 @@
 // Operators of the semi-implicit pressure projection (doc/theory.md §8.2): the mobility λ of eq. 8.5
-// against the 2×2 nodal system it condenses, and its limits.
+// against the 2×2 nodal system it condenses, and its limits; the assembled matrix against the
+// definition of K summed pair by pair.
 #include "core/PressureProjection.hpp"
+#include "core/Stencil.hpp"
 #include "core/TwoPhaseSolver.hpp"
 #include "support/Fixtures.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <map>
+#include <random>
 
 namespace {
 
@@ -94,5 +98,123 @@ TEST(PressureSystem, MatrixIsSymmetricWithAPositiveDiagonal)
 	EXPECT_LT(asymmetry, 1e-14 * size);
 	for (long r = 0; r < K.rows(); ++r) EXPECT_GT(K.coeff(r, r), 0) << "row " << r;
 }
+
+// K of eq. 8.7 by its definition (eqs. 8.3, 8.6), pair by pair over the water points:
+// K_IJ = Σ_p V_p [n_p/(Kw Δt) S_I S_J + Δt Σ_d λ_p,d ∂_d S_I ∂_d S_J], n_p and λ_p interpolated from
+// the nodes as the stage does (λ_I is the stage's own, eq. 8.5, checked above). The stage stores half
+// of K and factors the pair terms by axis (issue 18); its CSR matrix must equal this sum to
+// round-off, with the prescribed columns moved to the right-hand side: b_I − Σ_J K_IJ p̄_J. On a
+// periodic axis of 3 cells two stencil offsets reach one node, and their entries must add up.
+void expectMatrixIsThePairSum(bool periodicX)
+{
+	const Real         h = 0.1, dt = 1e-3;
+	const GridGeometry grid = GridGeometry::forDomain(Vec3::Zero(), Vec3(0.3, 0.3, 0.4), h, { periodicX, false, false });
+	GridFields         fields;
+	fields.resize(grid.nodeCount());
+	std::mt19937_64                      rng(11);
+	std::uniform_real_distribution<Real> ux(periodicX ? 0.0 : 0.03, periodicX ? 0.3 : 0.27), uy(0.03, 0.27), uz(0.03, 0.33), unit(-1, 1), len(0.015, 0.025);
+	SolidPointSet                        solid;
+	WaterPointSet                        fluid;
+	solid.resize(400);
+	fluid.resize(400);
+	for (std::size_t p = 0; p < solid.size(); ++p) {
+		solid.position[p]   = Vec3(ux(rng), uy(rng), uz(rng));
+		solid.mass[p]       = 2650 * 0.6 * 1.2e-4 * (1 + 0.2 * unit(rng));
+		solid.volume[p]     = solid.initialVolume[p] = 1.2e-4;
+		solid.halfLength[p] = solid.initialHalfLength[p] = Vec3(len(rng), len(rng), len(rng));
+		solid.porosity[p]   = 0.4;
+		fluid.position[p]   = Vec3(ux(rng), uy(rng), uz(rng));
+		fluid.mass[p]       = 1000 * 0.4 * 1.2e-4;
+		fluid.volume[p]     = 1.2e-4 * (1 + 0.3 * unit(rng));
+		fluid.halfLength[p] = Vec3(len(rng), len(rng), len(rng));
+		fluid.porePressure[p] = 1e3 * unit(rng);
+		fluid.porosity[p]     = 0.4;
+	}
+	SoilParameters soil;
+	WaterParameters water;
+	water.bulkModulus = 2.2e7; // a storage term of the size of the conductance
+	BoundaryConditions bcs;
+	bcs.periodic                                    = { periodicX, false, false };
+	for (int f = periodicX ? 2 : 0; f < faceCount; ++f) bcs.walls[f].water = WaterWall::Impermeable;
+	bcs.walls[static_cast<int>(Face::ZMax)].water   = WaterWall::Drained;
+	bcs.walls[static_cast<int>(Face::ZMax)].drainedPressure = 750;
+	std::vector<SolidSet>       solids { SolidSet { &solid, soil } };
+	std::vector<WaterPointSet*> waters { &fluid };
+	ScatterWorkspace            ws;
+	stages::resetGrid(fields);
+	stages::mapSolidToGrid<GimpKernel>(grid, solids, &water, Vec3::Zero(), fields, ws);
+	stages::computeNodalPorosity(fields);
+	stages::mapWaterToGrid<GimpKernel>(grid, waters, Vec3::Zero(), fields, ws);
+	PressureSystem system;
+	stages::classifyPressureNodes<GimpKernel>(grid, fields, waters, bcs, Vec3::Zero(), water.density, system);
+	// walls holding a phase along one axis at some nodes make λ differ between the axes (eq. 8.5 with holds)
+	ConstrainedNodes                 held;
+	std::vector<std::array<bool, 3>> heldSolid;
+	for (std::size_t I = 0; I < grid.nodeCount(); I += 3) {
+		NodeConstraint constraint;
+		constraint.water[1] = I % 2 == 0;
+		held.node.push_back(I);
+		held.constraint.push_back(constraint);
+		heldSolid.push_back({ I % 2 == 1, false, I % 4 == 1 });
+	}
+	stages::assemblePressureSystem<GimpKernel>(grid, fields, solids, waters, water, held, heldSolid, dt, 1e-12, 1e-12, system);
+	stages::buildPressureMatrix(grid, system);
+
+	std::map<std::pair<std::size_t, std::size_t>, Real> K; // grid nodes (I, J) → K_IJ
+	for (std::size_t p = 0; p < fluid.size(); ++p) {
+		Weights1D w[3];
+		detail::weightsAt<GimpKernel>(grid, fluid.position[p], fluid.halfLength[p], w);
+		std::vector<std::size_t> node;
+		std::vector<Real>        N;
+		std::vector<Vec3>        dN;
+		Real                     n = 0;
+		Vec3                     lambda = Vec3::Zero();
+		for (int c = 0; c < 3; ++c)
+			for (int b = 0; b < 3; ++b)
+				for (int a = 0; a < 3; ++a) {
+					const std::size_t I = grid.index(grid.wrap(0, w[0].first + a), grid.wrap(1, w[1].first + b), grid.wrap(2, w[2].first + c));
+					node.push_back(I);
+					N.push_back(w[0].value[a] * w[1].value[b] * w[2].value[c]);
+					dN.push_back(Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
+					                  w[0].value[a] * w[1].value[b] * w[2].gradient[c]));
+					n += N.back() * fields.porosity[I];
+					lambda += N.back() * system.mobility[I];
+				}
+		n = std::clamp<Real>(n, stages::minimumInterpolatedPorosity, 1);
+		const Real V = fluid.volume[p];
+		for (std::size_t i = 0; i < node.size(); ++i)
+			for (std::size_t j = 0; j < node.size(); ++j)
+				K[{ node[i], node[j] }] += V * (n / (water.bulkModulus * dt) * N[i] * N[j] + dt * dN[i].dot(lambda.cwiseProduct(dN[j])));
+	}
+	Real largest = 0;
+	for (const auto& [pair, value] : K) largest = std::max(largest, std::abs(value));
+	const Eigen::SparseMatrix<Real, Eigen::RowMajor>& A = system.matrix;
+	ASSERT_GT(A.rows(), 20);
+	Eigen::VectorXd expectedRhs(A.rows());
+	for (std::size_t r = 0; r < system.node.size(); ++r)
+		if (!system.fixed[r]) expectedRhs[system.unknown[r]] = system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
+	long expectedNonZeros = 0, fixedColumns = 0;
+	for (const auto& [pair, value] : K) {
+		const int r = system.row[pair.first], c = system.row[pair.second];
+		if (r < 0 || c < 0) { // a stencil node the point reaches with neither weight nor gradient has no pressure node
+			EXPECT_EQ(value, 0);
+			continue;
+		}
+		if (system.fixed[r]) continue;
+		if (system.fixed[c]) {
+			expectedRhs[system.unknown[r]] -= value * system.fixedValue[c];
+			fixedColumns += system.fixedValue[c] != 0;
+			continue;
+		}
+		if (value != 0) ++expectedNonZeros;
+		EXPECT_NEAR(A.coeff(system.unknown[r], system.unknown[c]), value, 1e-12 * largest) << "nodes " << pair.first << ", " << pair.second;
+	}
+	EXPECT_EQ(A.nonZeros(), expectedNonZeros);
+	EXPECT_GT(fixedColumns, 0); // the drained top's p̄ reached the right-hand side
+	EXPECT_LT((system.rhs - expectedRhs).norm(), 1e-12 * expectedRhs.norm());
+}
+
+TEST(PressureSystem, MatrixIsThePairSumOfItsDefinition) { expectMatrixIsThePairSum(false); }
+TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionAcrossAPeriodicSeamOfThreeCells) { expectMatrixIsThePairSum(true); }
 
 } // namespace
