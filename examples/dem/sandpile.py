@@ -1,6 +1,6 @@
 """The sand pile with DEM + pore fluid (YADE's PFV FlowEngine): the MPM pile's flume, geometry and
 heads (yade_mpm.sandpile.SUBMERGED with its crest lid) in a slice a few grains wide; the head rise is
-compressed in time (doc/dem.md says why that stays quasi-static here).
+compressed in time (doc/dem-comparison.md says why that stays quasi-static here).
 
 Run:  yade-double -n -x examples/dem/sandpile.py [--quick] [--control] [--ramp-time T] [--out DIR]
 

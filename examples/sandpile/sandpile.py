@@ -4,7 +4,8 @@ Run:  yade-double -n -x examples/sandpile/sandpile.py [--quick] [--out DIR]
       (or /usr/bin/python3 examples/sandpile/sandpile.py ...)
 
 The scene (flume, pile, sand, water, head history) is yade_mpm.sandpile.DEFAULT, documented there.
-3D: the flume's front and rear walls (y = 0, width) are smooth and impermeable, the base is an
+3D: the flume's front and rear walls (y = 0, width) are smooth and impermeable (or rough, a Coulomb
+contact, with --side-wall-friction μ), the base is an
 impermeable Coulomb contact (sand glued on it, δ = φ), the upstream face x = 0 is a drained inflow face held at the hydrostatic profile
 of the rising head H(t) (water enters as new water points), the pile's surface is a free surface
 that keeps the capillary suction above the phreatic line and is a seepage face (p = 0, water out,
@@ -12,7 +13,8 @@ none in) below it, and water that seeps out of the pile is taken by the filterin
 (removed once it has left the soil, its mass counted). Mohr–Coulomb sand with friction softening.
 
 Quick mode: cell h = 2 cm (6 cells over the pile height), a few minutes on 2 cores. Full mode:
-h = 1 cm. Both run the whole head history.
+h = 1 cm. Both run the whole head history. --sand-from-dem DIR takes the sand's strength from a DEM +
+PFV pile run (examples/dem/sandpile.py --out DIR: the drained triaxial test on its grains).
 
 Writes to DIR (default examples/sandpile/out[-quick]):
   sandpile.h5 + sandpile.xdmf     point fields over time (ParaView)
@@ -46,7 +48,7 @@ import numpy as np
 
 import yade_mpm
 from yade import O
-from yade_mpm import MpmHdf5Recorder, MpmSoilMat, MpmTwoPhaseEngine, MpmWaterMat, sandpile
+from yade_mpm import MpmHdf5Recorder, MpmSoilMat, MpmTwoPhaseEngine, MpmWaterMat, calibrate, sandpile
 
 parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
 parser.add_argument("--quick", action="store_true", help="2 cm cells: a few minutes on 2 cores (the CI test runs this)")
@@ -74,9 +76,17 @@ parser.add_argument("--lid-friction", type=float, default=0.0,
 parser.add_argument("--base", choices=("frictional", "fixed"), default="frictional",
                     help="the flume base: a Coulomb contact with the scene's base friction angle (default), or fixed (no slip, no lift-off)")
 parser.add_argument("--head-start", type=float, help="inflow water level at the start, also the pile's starting water table [m] (default the scene's 0.03 m)")
+parser.add_argument("--side-wall-friction", type=float, default=0.0, metavar="MU",
+                    help="Coulomb coefficient μ = tan δ of the flume's front and rear walls (y), a frictional contact (theory.md eq. 2.6); "
+                         "0 (default): smooth slip walls, the plane-strain pile")
+parser.add_argument("--sand-from-dem", metavar="DIR",
+                    help="take the sand's strength (φ, φ_r, ψ; base δ = φ) from a DEM + PFV pile run's DIR/summary.json "
+                         "(examples/dem/sandpile.py: the triaxial test on its grains; yade_mpm.calibrate.pile_scene_from_dem)")
 args = parser.parse_args(sys.argv[1:])
 if not args.lid_friction >= 0:
     raise SystemExit("--lid-friction must be ≥ 0 (a Coulomb coefficient); got %r" % args.lid_friction)
+if not args.side_wall_friction >= 0:
+    raise SystemExit("--side-wall-friction must be ≥ 0 (a Coulomb coefficient); got %r" % args.side_wall_friction)
 if args.lid_friction > 0 and not args.crest_lid:
     raise SystemExit("--lid-friction %r needs --crest-lid (there is no lid without it)" % args.lid_friction)
 
@@ -91,6 +101,14 @@ if args.ramp_time is not None or args.hold_time is not None or args.head_start i
                                 hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time,
                                 head_start=SCENE.head_start if args.head_start is None else args.head_start,
                                 head_end=SCENE.head_end if args.head_end is None else args.head_end)
+SAND_SOURCE = "yade_mpm.sandpile (documented lab-scale sand)"
+if args.sand_from_dem is not None:
+    dem_summary_path = os.path.join(args.sand_from_dem, "summary.json")
+    if not os.path.isfile(dem_summary_path):
+        raise SystemExit("--sand-from-dem %r: no summary.json there (a run of examples/dem/sandpile.py writes it)" % args.sand_from_dem)
+    with open(dem_summary_path) as f:
+        SCENE = calibrate.pile_scene_from_dem(SCENE, json.load(f))
+    SAND_SOURCE = "DEM pile's triaxial test, " + dem_summary_path
 SEMI_IMPLICIT = args.scheme == "semi-implicit"
 GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
 G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]
@@ -140,6 +158,7 @@ start_positions = solid.pos.copy()
 
 # --- engine: flume walls, inflow face, free surface, filtering cloth --------------------------------
 NO_TABLE = float("-inf")
+SIDE_WALL = "frictional" if args.side_wall_friction > 0 else "slip"
 engine = MpmTwoPhaseEngine(
     label="mpm", gravity=GRAVITY, domainMin=(0, 0, 0), domainMax=(SCENE.flume_length, SCENE.flume_width, SCENE.domain_height()),
     cellSize=CELL, shapeFunction="uGIMP",
@@ -151,8 +170,10 @@ engine = MpmTwoPhaseEngine(
     #            xMin (inflow)  xMax      yMin (front)   yMax (rear)    zMin (base)    zMax
     # zMax: open, or with a crest lid the domain's top at the crest: a Coulomb contact (pushes, never
     # pulls; μ = --lid-friction, smooth by default) that the water cannot cross
-    solidWalls=("slip",        "free",   "slip",        "slip",        args.base,     "frictional" if SCENE.crest_lid else "free"),
-    wallFriction=(0,           0,        0,             0,             math.tan(SCENE.base_friction_angle) if args.base == "frictional" else 0, args.lid_friction),
+    # yMin/yMax: smooth (plane strain) or, with --side-wall-friction μ > 0, a Coulomb contact like the base's
+    solidWalls=("slip",        "free",   SIDE_WALL,     SIDE_WALL,     args.base,     "frictional" if SCENE.crest_lid else "free"),
+    wallFriction=(0,           0,        args.side_wall_friction, args.side_wall_friction,
+                  math.tan(SCENE.base_friction_angle) if args.base == "frictional" else 0, args.lid_friction),
     waterWalls=("drained",     "free",   "impermeable", "impermeable", "impermeable", "impermeable" if SCENE.crest_lid else "free"),
     waterInflow=(True, False, False, False, False, False),
     drainedWaterTable=(SCENE.head_start, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE),
@@ -341,6 +362,8 @@ summary = {
     "cell_size_m": CELL,
     "points_per_phase_initial": int(len(positions)),
     "scene": {k: getattr(SCENE, k) for k in SCENE.__dataclass_fields__},
+    "sand_strength_source": SAND_SOURCE,
+    "side_wall_friction": args.side_wall_friction,
     "gravity_m_per_s2": GRAVITY.tolist(),
     "simulated_time_s": O.time,
     "stopped_unstable": stopped,

@@ -14,7 +14,14 @@ porosity is the assembly's. The water is PFV's fluid: its viscosity μ, incompre
 c_v = (k/μ) E_oed is the same in both models. The strength comes from a drained triaxial test on
 the same kind of assembly: the peak friction and dilatancy angles, and the friction angle at the end
 of the test as the residual one.
+
+The sand pile's MPM sand takes the strength of the DEM pile's own grains the same way:
+
+    scene = yade_mpm.calibrate.pile_scene_from_dem(yade_mpm.sandpile.SUBMERGED, json.load(open("dem-run/summary.json")))
+
+(the examples' `--sand-from-dem DIR`), so that the two piles differ by the model, not by the sand.
 """
+import dataclasses
 import math
 
 from yade.wrapper import MpmSoilMat, MpmWaterMat
@@ -57,3 +64,37 @@ def strength_from_triaxial(triaxial):
     peak, final = triaxial["peak_friction_angle"], triaxial["final_friction_angle"]
     return {"model": "MohrCoulomb", "frictionAngle": peak, "residualFrictionAngle": min(final, peak),
             "dilatancyAngle": max(0.0, min(triaxial["dilatancy_angle"], peak))}
+
+
+def pile_strength_from_dem(summary):
+    """The MPM sand's strength [rad] from a DEM + PFV pile's summary (dem_pile.run_case, its
+    summary.json): the drained triaxial test that run made on the pile's own grains at the crest's
+    confinement, already reduced by strength_from_triaxial's rules (peak, end-of-test as residual,
+    dilatancy). Returns SandPileScene keyword arguments: friction_angle, residual_friction_angle,
+    dilatancy_angle and base_friction_angle = friction_angle (the DEM base is a layer of the same grains
+    frozen in place, as the MPM flume's base is sand glued on: δ = φ)."""
+    triaxial = summary.get("triaxial") if isinstance(summary, dict) else None
+    if not isinstance(triaxial, dict):
+        raise ValueError("summary['triaxial'] is missing: the DEM pile's summary.json (yade_mpm.dem_pile.run_case) holds it")
+    angles = {}
+    for key in ("peak_friction_angle_deg", "residual_friction_angle_deg", "dilatancy_angle_deg"):
+        value = triaxial.get(key)
+        if not (isinstance(value, (int, float)) and math.isfinite(value)):
+            raise ValueError("summary['triaxial'][%r] = %r is not a finite angle in degrees" % (key, value))
+        angles[key] = math.radians(value)
+    peak, residual, dilatancy = angles["peak_friction_angle_deg"], angles["residual_friction_angle_deg"], angles["dilatancy_angle_deg"]
+    if not 0 < peak < math.pi / 2:
+        raise ValueError("summary['triaxial']['peak_friction_angle_deg'] = %r is outside the valid range (0, 90)" % math.degrees(peak))
+    if not 0 < residual <= peak:
+        raise ValueError("summary['triaxial']['residual_friction_angle_deg'] = %r is outside the valid range (0, %r] (up to the peak)"
+                         % (math.degrees(residual), math.degrees(peak)))
+    if not 0 <= dilatancy <= peak:
+        raise ValueError("summary['triaxial']['dilatancy_angle_deg'] = %r is outside the valid range [0, %r] (up to the peak)"
+                         % (math.degrees(dilatancy), math.degrees(peak)))
+    return {"friction_angle": peak, "residual_friction_angle": residual, "dilatancy_angle": dilatancy, "base_friction_angle": peak}
+
+
+def pile_scene_from_dem(scene, summary):
+    """`scene` (a sandpile.SandPileScene) with the strength of the DEM pile's grains
+    (pile_strength_from_dem); everything else, geometry and heads included, stays the scene's."""
+    return dataclasses.replace(scene, **pile_strength_from_dem(summary))

@@ -82,7 +82,8 @@ def _side(model, summary, columns, width, still, unit_weight, water_density):
         extra = {"lem_one_cell_onset_head_m": summary.get("lem_onset_head_m"), "inertia_scale": summary.get("inertia_scale"),
                  "inertia_release_head_m": None if release is None else float(np.interp(release, columns["time_s"], head)),
                  "peak_friction_angle_deg": math.degrees(summary["scene"]["friction_angle"]),
-                 "dilatancy_angle_deg": math.degrees(summary["scene"]["dilatancy_angle"])}
+                 "dilatancy_angle_deg": math.degrees(summary["scene"]["dilatancy_angle"]),
+                 "strength_from_dem": summary.get("sand_strength_source", "").startswith("DEM")}
     conductance = discharge / (head[late] - still)
     return dict(extra, model=model, onset_head_m=onset, sliding_surface=summary.get("sliding_surface"),
                 first_mobilised_zone=summary.get("first_mobilised_zone"), lem_onset_head_m=lem, bodies=bodies, wall_s=wall, simulated_s=simulated,
@@ -184,8 +185,9 @@ def report(out_dir, result):
         "| Bishop on the run's own pressure field, F = 1 at head [m] | %s (slides ≥ 1 cell), %s (≥ 3 cells) | %s (≥ 2 diameters) |"
         % (_m(mpm["lem_one_cell_onset_head_m"]), _m(mpm["lem_onset_head_m"]), _m(dem["lem_onset_head_m"])),
         "| MPM inertia scaling released at head [m] | %s (α = %s) | — |" % (_m(mpm.get("inertia_release_head_m")), mpm.get("inertia_scale")),
-        "| sand strength φ, ψ [°] | %.1f, %.1f (scene) | %.1f, %.1f (drained triaxial on the grains) |"
-        % (mpm["peak_friction_angle_deg"], mpm["dilatancy_angle_deg"], dem["peak_friction_angle_deg"], dem["dilatancy_angle_deg"]),
+        "| sand strength φ, ψ [°] | %.1f, %.1f (%s) | %.1f, %.1f (drained triaxial on the grains) |"
+        % (mpm["peak_friction_angle_deg"], mpm["dilatancy_angle_deg"], "the DEM grains' triaxial, `--sand-from-dem`" if mpm.get("strength_from_dem") else "scene",
+           dem["peak_friction_angle_deg"], dem["dilatancy_angle_deg"]),
         "| discharge per width and excess head before the onset [m s⁻¹] | %.3g | %.3g |"
         % (mpm["discharge_per_width_per_excess_head_m_per_s"] or math.nan, dem["discharge_per_width_per_excess_head_m_per_s"] or math.nan),
         "| first mobilised zone at the onset (x range; z range) [m] | %s | %s |" % tuple(_zone(s["first_mobilised_zone"]) for s in (mpm, dem)),
@@ -215,10 +217,12 @@ def report(out_dir, result):
         " the MPM sand is a continuum in the 10 cm flume; PFV's conductance comes from the grains' pores (coarse grains: a far"
         " larger discharge than the MPM sand's k, which changes the time scale of drainage, not the seepage force at a given"
         " gradient); the DEM head rise is compressed to %.2f s (quasi-static for the pore pressure, which follows the inflow"
-        " at once in both), the MPM's runs over a laboratory minute with inertia scaling; the DEM sand dilates more (ψ from"
-        " the triaxial) and its grains rotate against a rolling resistance calibrated to the MPM's φ; a grain layer under the"
+        " at once in both), the MPM's runs over a laboratory minute with inertia scaling; %s; a grain layer under the"
         " lid and at the walls is more open than the bulk." % (
-            1e3 * dem["grain_diameter_m"], dem["slice_width_m"] / dem["grain_diameter_m"], dem["ramp_time_s"]),
+            1e3 * dem["grain_diameter_m"], dem["slice_width_m"] / dem["grain_diameter_m"], dem["ramp_time_s"],
+            "the MPM sand has the DEM grains' triaxial strength (φ, φ_r, ψ), but a Mohr–Coulomb continuum with exponential"
+            " softening, where the grains rotate against a rolling resistance" if mpm.get("strength_from_dem") else
+            "the DEM sand dilates more (ψ from the triaxial) and its grains rotate against a rolling resistance calibrated to the MPM's φ"),
         "",
         "![probe pressures and slope-face displacement against the head](sandpile.png)",
         "",

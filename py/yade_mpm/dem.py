@@ -1,6 +1,6 @@
 """The DEM + pore-fluid reference of the oedometer, in YADE itself: spheres coupled to YADE's
 pore-scale finite-volume flow (PFV, ``FlowEngine``), with the continuum inputs measured on the same
-assembly (issue 16; the facts behind the set-up are in doc/dem.md).
+assembly (issue 16; the facts behind the set-up are in doc/dem-comparison.md).
 
     sample = yade_mpm.dem.oedometer_sample(grains=300)
     modulus = yade_mpm.dem.measure_oedometric_modulus(sample)         # E_oed and K0, drained cycle

@@ -1,6 +1,6 @@
 """The DEM + pore-fluid sand pile, in YADE itself: spheres coupled to YADE's pore-scale flow (PFV,
 ``FlowEngine``) in a slice of the MPM pile's flume, under the same head history (issue 16; the facts
-behind the set-up are in doc/dem.md, "The sand pile").
+behind the set-up are in doc/dem-comparison.md, "The sand pile").
 
     g = (0, 0, -9.81)
     scene = dataclasses.replace(yade_mpm.sandpile.SUBMERGED, crest_lid=True,   # the MPM pile's geometry and heads,
@@ -23,7 +23,7 @@ between the slope and the outflow wall: its pores are large, so the slope is a d
 The walls are YADE's ``aabbWalls`` in the order xMin, xMax, yMin, yMax, zMin, zMax (FlowEngine's
 boundary order); the axis z is vertical and x runs down the flume, as in the MPM example. The grains
 are spheres with rolling resistance (``CohFrictMat`` with ``etaRoll``, non-cohesive): spheres that
-roll freely are weaker than a 30° slope of real sand (doc/dem.md, the triaxial tests).
+roll freely are weaker than a 30° slope of real sand (doc/dem-comparison.md, the triaxial tests).
 """
 import dataclasses
 import math
@@ -91,7 +91,7 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.0
     crest); the grains within 1.7 radii of the base frozen (the rough base the MPM's frictional base
     stands for); the gate removed; the contact `friction_angle` and `rolling_resistance` (etaRoll
     [-], the rolling and twisting moments' cap in units of r Fn; 0.05 gives these grains the MPM
-    sand's 36° drained peak, doc/dem.md) switched on and the pile settled under buoyant gravity with
+    sand's 36° drained peak, doc/dem-comparison.md) switched on and the pile settled under buoyant gravity with
     the lid resting on the crest under `lid_pressure` [Pa] (default the weight of one grain radius of
     buoyant sand); then the lid is held where it rests. `young` [Pa] and `contact_poisson` [-] are
     the contact stiffness parameters; `wall_friction_angle` [rad] that of the flume's walls (front,
@@ -213,7 +213,7 @@ def raise_head(pile, scene, gravity, viscosity=None, record_interval=0.02, bound
     still water (updated every `boundary_update_steps` steps), the outflow wall at 0, the rest
     impermeable; stepped to scene.duration() from t = 0 (the scene's settle, rise and hold: pass a
     scene with a compressed history, e.g. dataclasses.replace(scene, head_ramp_time=2.0), see
-    doc/dem.md). Every `record_interval` [s] it records the head, the pore pressure at the scene's
+    doc/dem-comparison.md). Every `record_interval` [s] it records the head, the pore pressure at the scene's
     probe points (mid-slice), the fluxes through the inflow and outflow walls [m³ s⁻¹], the free
     grains' kinetic energy [J], the mean toe displacement along x and the mean displacement of the
     lower slope face [m]; `on_record(record, flow)`, if given, is called after each record (the

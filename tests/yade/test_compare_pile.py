@@ -10,7 +10,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from yade_mpm import compare_pile, sandpile
+from yade_mpm import calibrate, compare_pile, sandpile
 
 G = 9.81
 STILL = 0.15
@@ -100,3 +100,34 @@ def test_the_command_writes_the_report_and_refuses_a_scene_pfv_cannot_model(runs
     json.dump(summary, open(runs / "mpm" / "summary.json", "w"))
     with pytest.raises(ValueError, match=r"--mpm-run = .* is not a run of the submerged, lidded pile"):
         compare_pile.compare(runs / "mpm", runs / "dem")
+
+
+DEM_RUN = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "doc", "compare", "sandpile", "dem-run")
+
+
+def test_the_mpm_sand_takes_the_dem_grains_strength_and_nothing_else():
+    """calibrate.pile_scene_from_dem (the example's --sand-from-dem): the stored DEM pile's triaxial
+    angles become the MPM scene's φ, φ_r, ψ and the base's δ = φ to round-off (degrees to radians);
+    geometry, heads, stiffness and permeability stay the scene's."""
+    with open(os.path.join(DEM_RUN, "summary.json")) as f:
+        summary = json.load(f)
+    triaxial = summary["triaxial"]
+    scene = calibrate.pile_scene_from_dem(sandpile.SUBMERGED, summary)
+    assert math.degrees(scene.friction_angle) == pytest.approx(triaxial["peak_friction_angle_deg"], rel=1e-14)
+    assert math.degrees(scene.residual_friction_angle) == pytest.approx(triaxial["residual_friction_angle_deg"], rel=1e-14)
+    assert math.degrees(scene.dilatancy_angle) == pytest.approx(triaxial["dilatancy_angle_deg"], rel=1e-14)
+    assert scene.base_friction_angle == scene.friction_angle
+    unchanged = set(sandpile.SandPileScene.__dataclass_fields__) - {"friction_angle", "residual_friction_angle", "dilatancy_angle", "base_friction_angle"}
+    assert all(getattr(scene, k) == getattr(sandpile.SUBMERGED, k) for k in unchanged)
+    scene.validate()
+
+
+@pytest.mark.parametrize("triaxial, message", [(None, r"summary\['triaxial'\] is missing"),
+                                               ({"peak_friction_angle_deg": 36.0, "residual_friction_angle_deg": 40.0, "dilatancy_angle_deg": 5.0},
+                                                r"residual_friction_angle_deg'\] = 40.0 is outside the valid range \(0, 36.0\]"),
+                                               ({"peak_friction_angle_deg": 36.0, "residual_friction_angle_deg": 30.0, "dilatancy_angle_deg": float("nan")},
+                                                r"dilatancy_angle_deg'\] = nan is not a finite angle")])
+def test_a_dem_summary_without_a_valid_strength_is_refused_naming_the_key(triaxial, message):
+    summary = {} if triaxial is None else {"triaxial": triaxial}
+    with pytest.raises(ValueError, match=message):
+        calibrate.pile_scene_from_dem(sandpile.SUBMERGED, summary)

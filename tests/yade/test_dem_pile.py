@@ -143,7 +143,7 @@ def test_limit_equilibrium_on_the_runs_own_field_stands_at_rest_and_falls_as_the
     0.1 by head 0.22–0.24 m, and below 1 within the run. Where F crosses 1 against where the DEM
     yields is a measurement, not asserted: 0.206 against 0.217 m on one quick run, 0.182 against
     0.204 m on the full pile, and with a lid of grains the DEM stands to 0.27 m past a crossing at
-    0.187 m (doc/dem.md)."""
+    0.187 m (doc/dem-comparison.md)."""
     heads, factors = zip(*[(h, f) for h, f in rise["bishop"] if f is not None])
     assert factors[0] == pytest.approx(_infinite_slope_factor(PEAK_FRICTION, DILATANCY), abs=0.2), rise["bishop"]
     late = [f for h, f in zip(heads, factors) if h >= 0.22]
@@ -161,7 +161,7 @@ def test_the_summary_reports_what_the_record_holds(pile, rise):
 
 
 def test_rolling_resistance_gives_the_grains_the_mpm_sands_strength():
-    """Spheres that roll freely are weaker than the 30° slope needs (doc/dem.md: about 28° peak for
+    """Spheres that roll freely are weaker than the 30° slope needs (doc/dem-comparison.md: about 28° peak for
     30° contact friction); capping the rolling and twisting moments at 0.05 r Fn lifts the drained
     triaxial peak, at the pile's stress level (1 kPa) and contact stiffness, to the MPM sand's φ = 36°
     within 3° (300 grains: the peak is noisy by about ±1.5°)."""
