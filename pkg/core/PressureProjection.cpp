@@ -69,9 +69,94 @@ namespace {
 				}
 			}
 	}
+
+	// Filling of node I: its water points' volume over its in-domain support, 0 without support.
+	inline Real nodeFilling(const GridGeometry& grid, const GridFields& fields, const std::array<int, 3>& idx)
+	{
+		const Real full = grid.inDomainSupportVolume(idx[0], idx[1], idx[2]);
+		return full > 0 ? fields.water[grid.index(idx[0], idx[1], idx[2])].volume / full : 0;
+	}
 } // namespace
 
 namespace stages {
+	// The free surface between node planes (theory.md eq. 8.5b): a surface node I is tied to its
+	// free neighbour J inwards, p_I = c p_J with c = −s/(kh − s), s the distance from I to the surface
+	// along the axis (positive outwards) and kh that from J to I (k = 1, or 2 through a tied neighbour),
+	// so that p varies linearly from J to zero at the surface itself
+	// (the ghost value of Gibou et al. 2002, J. Comput. Phys. 176, 205–227; Enright et al. 2003 for free
+	// surfaces), not at the node half a cell outside. s comes from I's filling f, which for a plane
+	// surface normal to the axis and a hat support is f = (h − s)²/(2h²) (s ≥ 0), 1 − (h + s)²/(2h²)
+	// (s < 0). That inversion holds only for such a surface: a node is tied only where the fillings of
+	// its neighbours across the axis equal its own within filledShareTolerance (a flat surface), and
+	// the neighbour outwards (if any) is fuller no more than I; elsewhere it keeps p = 0 at the node.
+	constexpr Real filledShareTolerance = 0.125;
+	void tieSurfaceNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<char>& surface, PressureSystem& system)
+	{
+		const std::size_t active = system.node.size();
+		system.ghostMaster.assign(active, -1);
+		system.ghostFactor.assign(active, 0);
+		const Real h = grid.cellSize;
+		// the first pass ties the surface nodes next to a free node (distance one cell), the second those
+		// next to a tied one, to the same master two cells inwards (a surface just beyond a node plane
+		// leaves that plane's nodes under the filling threshold too)
+		for (int cells = 1; cells <= 2; ++cells) {
+			std::vector<int>  master(active, -1);
+			std::vector<Real> factor(active, 0);
+			for (std::size_t r = 0; r < active; ++r) {
+				if (!surface[r] || system.ghostMaster[r] >= 0) continue;
+				const std::array<int, 3> idx = grid.indices(system.node[r]);
+				const Real               f   = nodeFilling(grid, fields, idx);
+				auto neighbour = [&](int axis, int step, std::array<int, 3>& at) {
+					at       = idx;
+					at[axis] = grid.wrap(axis, idx[axis] + step);
+					return at[axis] >= 0 && at[axis] < grid.nodes[axis];
+				};
+				// inwards: the neighbour along an axis with the largest filling that is free (first pass)
+				// or tied to a free node one more cell along the same axis (second pass)
+				int  inner = -1, axis = -1, side = 0;
+				Real fullest = f;
+				for (int d = 0; d < 3; ++d)
+					for (int step : { -1, 1 }) {
+						std::array<int, 3> at;
+						if (!neighbour(d, step, at)) continue;
+						const int J = system.row[grid.index(at[0], at[1], at[2])];
+						if (J < 0) continue;
+						int candidate = -1;
+						if (cells == 1 && !system.fixed[J]) candidate = J;
+						if (cells == 2 && system.ghostMaster[J] >= 0) {
+							std::array<int, 3> beyond = at;
+							beyond[d]                 = grid.wrap(d, at[d] + step);
+							const bool inside         = beyond[d] >= 0 && beyond[d] < grid.nodes[d];
+							if (inside && system.row[grid.index(beyond[0], beyond[1], beyond[2])] == system.ghostMaster[J]) candidate = system.ghostMaster[J];
+						}
+						if (candidate < 0) continue;
+						const Real fJ = nodeFilling(grid, fields, at);
+						if (fJ > fullest) fullest = fJ, inner = candidate, axis = d, side = step;
+					}
+				if (inner < 0) continue;
+				bool               flat = true;
+				std::array<int, 3> at;
+				if (neighbour(axis, -side, at) && nodeFilling(grid, fields, at) > f) flat = false;
+				for (int d = 0; d < 3 && flat; ++d) {
+					if (d == axis) continue;
+					for (int step : { -1, 1 })
+						if (neighbour(d, step, at) && grid.inDomainSupportVolume(at[0], at[1], at[2]) > 0 &&
+						    std::abs(nodeFilling(grid, fields, at) - f) > filledShareTolerance)
+							flat = false;
+				}
+				if (!flat) continue;
+				const Real s = f <= 0.5 ? h * (1 - std::sqrt(2 * std::max<Real>(f, 0))) : -h * (1 - std::sqrt(2 * (1 - std::min<Real>(f, 1))));
+				// the same plane puts the surface at least (1 − √(2(1 − β))) h beyond a free node (filling ≥ β =
+				// freeSurfaceFilling): a master closer to it contradicts the plane
+				if (!(cells * h - s >= (1 - std::sqrt(2 * (1 - freeSurfaceFilling))) * h)) continue;
+				master[r] = inner;
+				factor[r] = -s / (cells * h - s);
+			}
+			for (std::size_t r = 0; r < active; ++r)
+				if (master[r] >= 0) system.ghostMaster[r] = master[r], system.ghostFactor[r] = factor[r];
+		}
+	}
+
 
 	template <class Kernel>
 	void classifyPressureNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
@@ -103,6 +188,7 @@ namespace stages {
 		const std::size_t active = system.node.size();
 		system.fixed.assign(active, 0);
 		system.fixedValue.assign(active, 0);
+		std::vector<char> surface(active, 0); // fixed by the free-surface filling, not by a wall
 		for (std::size_t r = 0; r < active; ++r) {
 			const std::size_t        I   = system.node[r];
 			const std::array<int, 3> idx = grid.indices(I);
@@ -132,9 +218,10 @@ namespace stages {
 				// weights: left free, its pressure is all but undetermined, and a solid point a hair
 				// closer to the wall than its water point would pick it up
 				const Real full = grid.inDomainSupportVolume(idx[0], idx[1], idx[2]);
-				if (!(full > 0) || fields.water[I].volume < freeSurfaceFilling * full) system.fixed[r] = 1;
+				if (!(full > 0) || fields.water[I].volume < freeSurfaceFilling * full) system.fixed[r] = 1, surface[r] = 1;
 			}
 		}
+		tieSurfaceNodes(grid, fields, surface, system);
 	}
 
 	template <class Kernel>
@@ -310,37 +397,52 @@ namespace stages {
 			if (!system.fixed[r]) system.unknown[r] = n++;
 		system.rhs.resize(n);
 		// CSR of the free rows, the prescribed columns moved to the right-hand side. Each stored pair
-		// (r, J) of the upper half gives K_rJ to row r and K_Jr = K_rJ to row J. Rows are visited in
-		// grid order, so row u receives its lower entries (from earlier rows) and then its own upper
-		// ones in column order; only a periodic axis that wrapped breaks the order, and on one of 3
-		// cells two offsets reach the same node: such rows are sorted and merged afterwards.
-		using Pair         = PressureSystem::FreePair;
-		std::vector<Pair>& pairs = system.pairScratch;
+		// (r, J) of the upper half gives K_rJ to row r and K_Jr = K_rJ to row J. A surface node tied to
+		// a free one (eq. 8.5b, p_r = c p_m) is eliminated: p = T p̂, K̂ = TᵀKT, b̂ = Tᵀb, so its row and
+		// column join its master's with the factor c (symmetric, positive definite as K). Rows are visited
+		// in grid order, so row u mostly receives its lower entries (from earlier rows) and then its own
+		// upper ones in column order; a tied node, a periodic axis that wrapped or, on one of 3 cells, two
+		// offsets reaching the same node break the order: such rows are sorted and merged afterwards.
+		system.tiedUnknown.assign(active, -1);
+		system.tiedWeight.assign(active, 1);
+		for (std::size_t r = 0; r < active; ++r) {
+			if (!system.fixed[r]) system.tiedUnknown[r] = system.unknown[r];
+			else if (!system.ghostMaster.empty() && system.ghostMaster[r] >= 0 && !system.fixed[system.ghostMaster[r]])
+				system.tiedUnknown[r] = system.unknown[system.ghostMaster[r]], system.tiedWeight[r] = system.ghostFactor[r];
+		}
+		const std::vector<int>&  unknownOf = system.tiedUnknown;
+		const std::vector<Real>& weightOf  = system.tiedWeight;
+		using Pair                         = PressureSystem::FreePair;
+		std::vector<Pair>& pairs           = system.pairScratch;
 		pairs.clear();
 		for (int u = 0; u < n; ++u) system.rhs[u] = 0;
 		for (std::size_t r = 0; r < active; ++r)
-			if (!system.fixed[r]) system.rhs[system.unknown[r]] = system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
+			if (unknownOf[r] >= 0) system.rhs[unknownOf[r]] += weightOf[r] * system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
 		std::vector<int>& count = system.rowCount;
 		count.assign(n + 1, 0);
+		auto add = [&](int row, int column, Real value) {
+			pairs.push_back(Pair { row, column, value });
+			++count[row + 1];
+			if (column != row) ++count[column + 1];
+		};
 		for (std::size_t r = 0; r < active; ++r) {
 			const Real*              k   = system.rows.data() + r * PressureSystem::rowStride;
 			const std::array<int, 3> idx = grid.indices(system.node[r]);
-			const bool               rowFixed = system.fixed[r];
+			const int                ur  = unknownOf[r];
 			for (int o = centreSlot; o < PressureSystem::offsets; ++o) {
 				const Real value = k[o - centreSlot];
 				if (value == 0) continue; // a non-zero coefficient joins two nodes of one stencil: both on the grid
 				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, c = o / 25 - 2;
-				const int J = system.row[grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c))];
-				const bool columnFixed = system.fixed[J];
-				if (rowFixed && columnFixed) continue;
-				if (columnFixed) system.rhs[system.unknown[r]] -= value * system.fixedValue[J];
-				else if (rowFixed) system.rhs[system.unknown[J]] -= value * system.fixedValue[r];
-				else {
-					const int ur = system.unknown[r], uJ = system.unknown[J];
-					pairs.push_back(Pair { ur, uJ, value });
-					++count[ur + 1];
-					if (uJ != ur) ++count[uJ + 1];
-				}
+				const int J  = system.row[grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c))];
+				const int uJ = unknownOf[J];
+				if (o == centreSlot) {
+					if (ur >= 0) add(ur, ur, weightOf[r] * weightOf[r] * value);
+				} else if (ur >= 0 && uJ >= 0) {
+					const Real tied = weightOf[r] * weightOf[J] * value;
+					if (ur == uJ) add(ur, ur, 2 * tied); // a tied node and its master: K_rJ and K_Jr both land on the diagonal
+					else add(ur, uJ, tied);
+				} else if (ur >= 0) system.rhs[ur] -= weightOf[r] * value * system.fixedValue[J];
+				else if (uJ >= 0) system.rhs[uJ] -= weightOf[J] * value * system.fixedValue[r];
 			}
 		}
 		for (int i = 0; i < n; ++i) count[i + 1] += count[i];
@@ -456,8 +558,8 @@ namespace stages {
 		if (plate) {
 			coupling.setZero(n);
 			for (std::size_t r = 0; r < active; ++r) {
-				if (system.fixed[r]) fixedShare += system.plateCoupling[r] * system.fixedValue[r];
-				else coupling[system.unknown[r]] = system.plateCoupling[r];
+				if (system.tiedUnknown[r] >= 0) coupling[system.tiedUnknown[r]] += system.tiedWeight[r] * system.plateCoupling[r];
+				else fixedShare += system.plateCoupling[r] * system.fixedValue[r];
 			}
 			system.rhs -= system.plateScale * fixedShare * coupling;
 		}
@@ -473,9 +575,9 @@ namespace stages {
 		system.previousNode.clear();
 		system.previousSolution.resize(n);
 		for (std::size_t r = 0; r < active; ++r) {
+			if (system.tiedUnknown[r] >= 0) system.nodalPressure[system.node[r]] = system.tiedWeight[r] * system.solution[system.tiedUnknown[r]];
 			if (system.fixed[r]) continue;
 			const int u = system.unknown[r];
-			system.nodalPressure[system.node[r]] = system.solution[u];
 			system.previousSolution[system.previousNode.size()] = system.solution[u];
 			system.previousNode.push_back(system.node[r]);
 		}
@@ -614,7 +716,7 @@ namespace stages {
 		forms.compact = q.dot(system.matrix * q);
 		std::vector<Real> pressure(grid.nodeCount(), 0);
 		for (std::size_t r = 0; r < system.node.size(); ++r)
-			if (!system.fixed[r]) pressure[system.node[r]] = freePressures[static_cast<std::size_t>(system.unknown[r])];
+			if (system.tiedUnknown[r] >= 0) pressure[system.node[r]] = system.tiedWeight[r] * freePressures[static_cast<std::size_t>(system.tiedUnknown[r])];
 		accumulatePressureForces<Kernel>(grid, fields, solids, sets, pressure, false, system);
 		Real exact = 0;
 		forEachPressureIncrement(fields, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, system,
@@ -647,7 +749,7 @@ namespace stages {
 		if (plate && !system.plateCoupling.empty() && system.plateScale > 0) {
 			coupling.setZero(n);
 			for (std::size_t r = 0; r < active; ++r)
-				if (!system.fixed[r]) coupling[system.unknown[r]] = system.plateCoupling[r];
+				if (system.tiedUnknown[r] >= 0) coupling[system.tiedUnknown[r]] += system.tiedWeight[r] * system.plateCoupling[r];
 		}
 		std::vector<Vec3>                      ds(nodes), dw(nodes), mixture(nodes), relative(nodes), skeleton(nodes);
 		std::vector<Real>                      balance;
@@ -717,8 +819,10 @@ namespace stages {
 				});
 			}
 			// the exact projection's residual b − (C q/Δt + Bᵀδ(q)) on the free rows, and K Δq = it
+			residual.setZero(n);
 			for (std::size_t r = 0; r < active; ++r)
-				if (!system.fixed[r]) residual[system.unknown[r]] = system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot] - balance[r];
+				if (system.tiedUnknown[r] >= 0)
+					residual[system.tiedUnknown[r]] += system.tiedWeight[r] * (system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot] - balance[r]);
 			step.setZero(n);
 			if (!solveFreeRows(system, residual, step, tolerance, coupling, report)) {
 				std::ostringstream msg;
@@ -727,7 +831,7 @@ namespace stages {
 				throw InstabilityError(msg.str());
 			}
 			for (std::size_t r = 0; r < active; ++r)
-				if (!system.fixed[r]) system.nodalPressure[system.node[r]] += step[system.unknown[r]];
+				if (system.tiedUnknown[r] >= 0) system.nodalPressure[system.node[r]] += system.tiedWeight[r] * step[system.tiedUnknown[r]];
 		}
 		// the warm start and the plate's force follow the corrected pressure
 		for (std::size_t e = 0; e < system.previousNode.size(); ++e) system.previousSolution[e] = system.nodalPressure[system.previousNode[e]];

@@ -63,6 +63,10 @@ struct PressureSystem {
 	std::vector<char>        fixed;          // per pressure node: the pressure is prescribed
 	std::vector<Real>        fixedValue;     // per pressure node: prescribed p^{n+1} where fixed [Pa]
 	std::vector<int>         unknown;        // per pressure node: its index among the unknowns, −1 where fixed
+	std::vector<int>         ghostMaster;    // per pressure node: a free-surface node's free neighbour inwards whose pressure it follows (eq. 8.5b), −1: none
+	std::vector<Real>        ghostFactor;    // per pressure node: c of p = c p_master (eq. 8.5b) [-]
+	std::vector<int>         tiedUnknown;    // per pressure node: the unknown its pressure is (free), or follows (tied), −1: prescribed
+	std::vector<Real>        tiedWeight;     // per pressure node: 1 (free) or c (tied) [-]
 	std::vector<Real>        rows;           // per pressure node: rowStride values (K's upper half [m³ s⁻¹ Pa⁻¹], then b [m³ s⁻¹])
 	std::vector<std::vector<Real>> rowBuffers; // per extra thread
 	std::vector<Real>        nodalPressure;   // per grid node: p^{n+1}, 0 off the pressure nodes [Pa]

@@ -190,26 +190,37 @@ void expectMatrixIsThePairSum(bool periodicX)
 	for (const auto& [pair, value] : K) largest = std::max(largest, std::abs(value));
 	const Eigen::SparseMatrix<Real, Eigen::RowMajor>& A = system.matrix;
 	ASSERT_GT(A.rows(), 20);
-	Eigen::VectorXd expectedRhs(A.rows());
+	// a free-surface node tied to a free one (eq. 8.5b, p_r = c p_m, the stage's tiedUnknown/tiedWeight)
+	// is eliminated: Â = TᵀKT, b̂ = Tᵀ(b − K p̄)
+	const auto& unknownOf = system.tiedUnknown;
+	const auto& weightOf  = system.tiedWeight;
+	Eigen::VectorXd expectedRhs = Eigen::VectorXd::Zero(A.rows());
 	for (std::size_t r = 0; r < system.node.size(); ++r)
-		if (!system.fixed[r]) expectedRhs[system.unknown[r]] = system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
-	long expectedNonZeros = 0, fixedColumns = 0;
+		if (unknownOf[r] >= 0) expectedRhs[unknownOf[r]] += weightOf[r] * system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
+	std::map<std::pair<int, int>, Real> expected;
+	long fixedColumns = 0, tied = 0;
+	for (std::size_t r = 0; r < system.node.size(); ++r) tied += system.fixed[r] && unknownOf[r] >= 0;
 	for (const auto& [pair, value] : K) {
 		const int r = system.row[pair.first], c = system.row[pair.second];
 		if (r < 0 || c < 0) { // a stencil node the point reaches with neither weight nor gradient has no pressure node
 			EXPECT_EQ(value, 0);
 			continue;
 		}
-		if (system.fixed[r]) continue;
-		if (system.fixed[c]) {
-			expectedRhs[system.unknown[r]] -= value * system.fixedValue[c];
+		if (unknownOf[r] < 0) continue;
+		if (unknownOf[c] < 0) {
+			expectedRhs[unknownOf[r]] -= weightOf[r] * value * system.fixedValue[c];
 			fixedColumns += system.fixedValue[c] != 0;
 			continue;
 		}
+		expected[{ unknownOf[r], unknownOf[c] }] += weightOf[r] * weightOf[c] * value;
+	}
+	long expectedNonZeros = 0;
+	for (const auto& [pair, value] : expected) {
 		if (value != 0) ++expectedNonZeros;
-		EXPECT_NEAR(A.coeff(system.unknown[r], system.unknown[c]), value, 1e-12 * largest) << "nodes " << pair.first << ", " << pair.second;
+		EXPECT_NEAR(A.coeff(pair.first, pair.second), value, 1e-12 * largest) << "unknowns " << pair.first << ", " << pair.second;
 	}
 	EXPECT_EQ(A.nonZeros(), expectedNonZeros);
+	std::printf("%ld unknowns, %ld surface nodes tied to a free neighbour\n", static_cast<long>(A.rows()), tied);
 	EXPECT_GT(fixedColumns, 0); // the drained top's p̄ reached the right-hand side
 	EXPECT_LT((system.rhs - expectedRhs).norm(), 1e-12 * expectedRhs.norm());
 }
