@@ -106,6 +106,9 @@ namespace stages {
 				if (!surface[r] || system.ghostMaster[r] >= 0) continue;
 				const std::array<int, 3> idx = grid.indices(system.node[r]);
 				const Real               f   = nodeFilling(grid, fields, idx);
+				// a node whose support holds water only by the round-off tail of the weights (a point's
+				// domain ending on its support's edge) has no surface in its support to extrapolate to
+				if (!(f > std::numeric_limits<Real>::epsilon())) continue;
 				auto neighbour = [&](int axis, int step, std::array<int, 3>& at) {
 					at       = idx;
 					at[axis] = grid.wrap(axis, idx[axis] + step);
