@@ -107,7 +107,9 @@ namespace stages {
 
 	// Pressure nodes and their conditions (theory.md §8.5): every grid node a water point's stencil
 	// reaches; prescribed pressures on the wall planes (and beyond) of drained faces, p̄(t^{n+1}),
-	// and of free water faces and free-surface nodes (filling below freeSurfaceFilling), p = 0.
+	// and of free water faces and free-surface nodes (filling below freeSurfaceFilling), p = 0 — or,
+	// where the surface is a plane across an axis, the surface node tied to a free node inwards so that
+	// p vanishes at the surface itself (eq. 8.5b: ghostMaster, ghostFactor).
 	template <class Kernel>
 	void classifyPressureNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
 	                           const Vec3& gravity, Real waterDensity, PressureSystem& system);
