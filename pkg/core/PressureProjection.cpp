@@ -459,7 +459,7 @@ namespace stages {
 			column[cursor[e.row]] = e.column, value[cursor[e.row]++] = e.value;
 			if (e.column != e.row) column[cursor[e.column]] = e.row, value[cursor[e.column]++] = e.value;
 		}
-		// sort (where a periodic axis wrapped) and merge each row in place; `merged` keeps the new lengths
+		// sort and merge in place the rows out of order (a tied node's, a wrapped periodic axis's); `merged` keeps the new lengths
 		std::vector<int>& merged = system.cursorScratch;
 #pragma omp parallel for schedule(static) if(n > static_cast<int>(parallelThreshold))
 		for (int u = 0; u < n; ++u) {
