@@ -13,8 +13,9 @@ none in) below it, and water that seeps out of the pile is taken by the filterin
 (removed once it has left the soil, its mass counted). Mohr–Coulomb sand with friction softening.
 
 Quick mode: cell h = 2 cm (6 cells over the pile height), a few minutes on 2 cores. Full mode:
-h = 1 cm. Both run the whole head history. --sand-from-dem DIR takes the sand's strength from a DEM +
-PFV pile run (examples/dem/sandpile.py --out DIR: the drained triaxial test on its grains).
+h = 1 cm. Both run the whole head history. --sand-from-dem DIR takes the sand from a DEM + PFV pile
+run (examples/dem/sandpile.py --out DIR: strength from the drained triaxial test on its grains,
+stiffness, porosity and permeability from the oedometer and flow test on them).
 
 Writes to DIR (default examples/sandpile/out[-quick]):
   sandpile.h5 + sandpile.xdmf     point fields over time (ParaView)
@@ -25,7 +26,8 @@ Writes to DIR (default examples/sandpile/out[-quick]):
                                   Bishop's factor of safety on the run's own pore pressures
   time_series.csv                 the same numbers
   summary.json                    failure head and time, kinematic onset (onset_head_m), run-out
-                                  (runout_m), deposit profile, mobilised volume, sliding surface,
+                                  (runout_m), deposit profile, mobilised volume, the first mobilised
+                                  zone at the onset, sliding surface,
                                   limit-equilibrium onset heads (lem_onset_head_m; lem_deep_onset_head_m
                                   for slides ≥ 3 cells deep), water balance
                                   (injected_kg, removed_kg, relative_residual), run time
@@ -80,8 +82,9 @@ parser.add_argument("--side-wall-friction", type=float, default=0.0, metavar="MU
                     help="Coulomb coefficient μ = tan δ of the flume's front and rear walls (y), a frictional contact (theory.md eq. 2.6); "
                          "0 (default): smooth slip walls, the plane-strain pile")
 parser.add_argument("--sand-from-dem", metavar="DIR",
-                    help="take the sand's strength (φ, φ_r, ψ; base δ = φ) from a DEM + PFV pile run's DIR/summary.json "
-                         "(examples/dem/sandpile.py: the triaxial test on its grains; yade_mpm.calibrate.pile_scene_from_dem)")
+                    help="take the sand (φ, φ_r, ψ, base δ = φ; E and ν from E_oed and K0; n; k) from a DEM + PFV pile run's "
+                         "DIR/summary.json (examples/dem/sandpile.py: the triaxial, oedometer and flow tests on its grains; "
+                         "yade_mpm.calibrate.pile_scene_from_dem)")
 args = parser.parse_args(sys.argv[1:])
 if not args.lid_friction >= 0:
     raise SystemExit("--lid-friction must be ≥ 0 (a Coulomb coefficient); got %r" % args.lid_friction)
@@ -108,7 +111,7 @@ if args.sand_from_dem is not None:
         raise SystemExit("--sand-from-dem %r: no summary.json there (a run of examples/dem/sandpile.py writes it)" % args.sand_from_dem)
     with open(dem_summary_path) as f:
         SCENE = calibrate.pile_scene_from_dem(SCENE, json.load(f))
-    SAND_SOURCE = "DEM pile's triaxial test, " + dem_summary_path
+    SAND_SOURCE = "DEM pile's triaxial, oedometer and flow tests on its grains, " + dem_summary_path
 SEMI_IMPLICIT = args.scheme == "semi-implicit"
 GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
 G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]
@@ -134,6 +137,18 @@ if not args.inertia_scale >= 1:
 SCENE.validate()
 if not (SCENE.head_ramp_time > 0 and SCENE.hold_time >= 0):
     raise ValueError("--ramp-time = %r s and --hold-time = %r s must lie in (0, inf) and [0, inf)" % (SCENE.head_ramp_time, SCENE.hold_time))
+# Inertia scaling keeps drainage real only while the scaled time in which drag relaxes the water's
+# flow relative to the skeleton, α τ with τ = ρsat κ/μw (theory.md eq. 4.8b and the drainage group Π
+# of §8), stays small against the head rise: the pore pressure then lags the inflow's head by about
+# α τ/T_rise of the rise. 2% is allowed (coarse DEM grains, κ ~ 1e-7 m², limit α to a few units).
+RELAXATION = ((1 - SCENE.porosity) * SCENE.grain_density + SCENE.porosity * SCENE.water_density) \
+    * SCENE.intrinsic_permeability(GRAVITY) / SCENE.water_viscosity  # τ [s]
+LAG_SHARE = 0.02  # the largest allowed α τ / T_rise [-]
+if args.inertia_scale > 1 and args.inertia_scale * RELAXATION > LAG_SHARE * SCENE.head_ramp_time:  # α = 1 is the true inertia
+    raise ValueError("--inertia-scale = %r is outside the valid range [1, %.3g] for this sand and head rise: the scaled drag "
+                     "relaxation time α ρsat κ/μw (τ = %.3g s unscaled) must stay within %g of the rise's %g s"
+                     % (args.inertia_scale, max(1.0, LAG_SHARE * SCENE.head_ramp_time / RELAXATION), RELAXATION, LAG_SHARE,
+                        SCENE.head_ramp_time))
 os.makedirs(OUT, exist_ok=True)
 
 # --- materials and points -------------------------------------------------------------------------
@@ -232,6 +247,7 @@ O.stopAtTime = DURATION  # the end of the head history; also what the progress E
 steps_per_record = int(round(RECORD_INTERVAL / O.dt))
 records_per_frame = int(round(FIELD_INTERVAL / RECORD_INTERVAL))
 rows, snapshots = [], {}
+record_positions = []  # the solid points' positions at each record (float32): the first mobilised zone is read at the onset
 lem_records = []  # (time, head, critical circle, critical circle ≥ DEEP_SLIDE_CELLS deep or None) of each limit-equilibrium evaluation
 failure = None
 settled = None
@@ -275,8 +291,10 @@ while O.time < DURATION - 1e-12:
         row["lem_factor_of_safety"] = circle.factor
         lem_records.append((O.time, row["head_m"], circle, deep))
     rows.append(row)
+    record_positions.append(solid.pos.astype(np.float32))
     if settled is None and O.time >= SCENE.settle_time - 1e-9:
         settled = dict(row)
+        rise_start_positions = solid.pos.copy()  # where the points stand when the head starts to rise
         snapshots["end of settling"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
     if failure is None and row["face_displacement_m"] > FAILURE_DISPLACEMENT:
         failure = dict(row)
@@ -352,6 +370,11 @@ onset = None if onset_index is None else {"time_s": float(times[onset_index]), "
 kinetic_index = yade_mpm.analysis.kinetic_onset(times, [r["kinetic_energy_J"] for r in rows])
 kinetic = None if kinetic_index is None else {"time_s": float(times[kinetic_index]), "head_m": rows[kinetic_index]["head_m"],
                                               "criterion": "kinetic energy of the solid grows at each of the next 5 records and by ≥ 10× (yade_mpm.analysis.kinetic_onset)"}
+# the first mobilised zone: the tenth of the solid points displaced most since the rise began, at the
+# onset (the DEM pile's reading, yade_mpm.dem_pile)
+first_zone = None
+if onset_index is not None and settled is not None:
+    first_zone = yade_mpm.analysis.mobilised_zone(rise_start_positions, record_positions[onset_index])
 runout = yade_mpm.analysis.toe_runout(start_positions, solid.pos, toe_x=float(start_positions[:, 0].max()), base_band=2 * CELL)
 deposit_x, deposit_z = yade_mpm.analysis.deposit_profile(solid.pos, np.arange(0, SCENE.flume_length + spacing, 2 * spacing), half_height=0.5 * spacing)
 mobilised, mobilised_fraction = yade_mpm.analysis.mobilised_volume(start_positions, solid.pos, solid.volume, displacement=spacing)
@@ -387,6 +410,7 @@ summary = {
     "onset": onset,
     "kinetic_onset": kinetic,
     "onset_head_m": None if onset is None else onset["head_m"],
+    "first_mobilised_zone": first_zone,
     "lem_onset_head_m": lem_summary["lem_onset_head_m"],
     "lem_deep_onset_head_m": lem_summary["lem_deep_onset_head_m"],
     "runout_m": runout,

@@ -94,11 +94,31 @@ def mobilised_volume(start_positions, positions, volumes, displacement):
     return float(v[moved].sum()), (float(v[moved].sum()) / total if total > 0 else 0.0)
 
 
+def mobilised_zone(reference_positions, positions, fraction=0.1):
+    """Where the motion concentrates: the `fraction` of the bodies (grains or solid points) displaced
+    most from `reference_positions` (e.g. where they stood when the load started to rise) to
+    `positions`, described by their reference positions' x and z range and centroid [m], the least
+    displacement among them [m] and their count. The same reading for a DEM and an MPM run (issue 16:
+    the first mobilised zone at the onset)."""
+    if not 0 < fraction <= 1:
+        raise ValueError("fraction = %r is outside the valid range (0, 1]" % (fraction,))
+    reference = np.asarray(reference_positions, dtype=float)
+    moved = np.linalg.norm(np.asarray(positions, dtype=float) - reference, axis=1)
+    chosen = np.argsort(moved, kind="stable")[-max(1, int(round(fraction * len(moved)))):]
+    x, z = reference[chosen, 0], reference[chosen, 2]
+    return {"x_range_m": [float(x.min()), float(x.max())], "z_range_m": [float(z.min()), float(z.max())],
+            "centroid_m": [float(x.mean()), float(z.mean())], "least_displacement_m": float(moved[chosen].min()), "count": int(len(chosen))}
+
+
 def falls_below(loads, values, level=1.0):
-    """The load at which `values` (e.g. a factor of safety evaluated at a rising head) first falls
-    from ≥ level to < level, linear between the two records; None entries (no evaluation) are
-    skipped; None if it never does."""
+    """The load at which `values` (e.g. a factor of safety evaluated at a rising head) first lies
+    below `level`: where it first falls from ≥ level to < level, linear between the two records, or
+    the first load if it starts below (a slope already short of equilibrium at rest: a later fall
+    after a reshaped slope's rise is not its onset); None entries (no evaluation) are skipped;
+    None if it never does."""
     pairs = [(q, v) for q, v in zip(loads, values) if v is not None]
+    if pairs and pairs[0][1] < level:
+        return pairs[0][0]
     for (q0, v0), (q1, v1) in zip(pairs, pairs[1:]):
         if v0 >= level > v1:
             return q0 + (v0 - level) / (v0 - v1) * (q1 - q0)

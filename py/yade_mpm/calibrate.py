@@ -15,7 +15,8 @@ c_v = (k/μ) E_oed is the same in both models. The strength comes from a drained
 the same kind of assembly: the peak friction and dilatancy angles, and the friction angle at the end
 of the test as the residual one.
 
-The sand pile's MPM sand takes the strength of the DEM pile's own grains the same way:
+The sand pile's MPM sand takes the strength, stiffness, porosity and permeability of the DEM pile's
+own grains the same way (the triaxial, oedometer and flow tests that run made on them):
 
     scene = yade_mpm.calibrate.pile_scene_from_dem(yade_mpm.sandpile.SUBMERGED, json.load(open("dem-run/summary.json")))
 
@@ -94,7 +95,38 @@ def pile_strength_from_dem(summary):
     return {"friction_angle": peak, "residual_friction_angle": residual, "dilatancy_angle": dilatancy, "base_friction_angle": peak}
 
 
+def pile_sand_from_dem(summary, water_density, water_viscosity):
+    """The MPM sand's stiffness, porosity and permeability from a DEM + PFV pile's summary
+    (dem_pile.run_case: the oedometer and flow test on the pile's own grains, dem_pile.sand_properties):
+    E and ν from E_oed and K0 (elastic_constants), n, and the hydraulic conductivity
+    k = κ ρw |g| / μw of the MPM scene's water under the DEM run's gravity, so that the MPM sand's
+    intrinsic permeability is the grains' κ. Returns SandPileScene keyword arguments."""
+    sand = summary.get("oedometer") if isinstance(summary, dict) else None
+    if not isinstance(sand, dict):
+        raise ValueError("summary['oedometer'] is missing: the DEM pile's summary.json (yade_mpm.dem_pile.run_case) holds it since "
+                         "the pile grains' oedometer and flow test were added; re-run examples/dem/sandpile.py")
+    values = {}
+    for key in ("oedometric_modulus_Pa", "lateral_ratio", "porosity", "intrinsic_permeability_m2"):
+        value = sand.get(key)
+        if not (isinstance(value, (int, float)) and math.isfinite(value)):
+            raise ValueError("summary['oedometer'][%r] = %r is not a finite number" % (key, value))
+        values[key] = value
+    if not 0 < values["porosity"] < 1:
+        raise ValueError("summary['oedometer']['porosity'] = %r is outside the valid range (0, 1)" % values["porosity"])
+    if not values["intrinsic_permeability_m2"] > 0:
+        raise ValueError("summary['oedometer']['intrinsic_permeability_m2'] = %r is outside the valid range (0, inf) m²"
+                         % values["intrinsic_permeability_m2"])
+    gravity = summary.get("gravity_m_per_s2")
+    if not (isinstance(gravity, (list, tuple)) and len(gravity) == 3 and math.hypot(*gravity) > 0):
+        raise ValueError("summary['gravity_m_per_s2'] = %r is not a non-zero 3-vector [m s⁻²]" % (gravity,))
+    young, nu = elastic_constants(values["oedometric_modulus_Pa"], values["lateral_ratio"])
+    return {"young_modulus": young, "poisson_ratio": nu, "porosity": values["porosity"],
+            "hydraulic_conductivity": values["intrinsic_permeability_m2"] * water_density * math.hypot(*gravity) / water_viscosity}
+
+
 def pile_scene_from_dem(scene, summary):
-    """`scene` (a sandpile.SandPileScene) with the strength of the DEM pile's grains
-    (pile_strength_from_dem); everything else, geometry and heads included, stays the scene's."""
-    return dataclasses.replace(scene, **pile_strength_from_dem(summary))
+    """`scene` (a sandpile.SandPileScene) with the sand of the DEM pile's grains: their strength
+    (pile_strength_from_dem) and their stiffness, porosity and permeability (pile_sand_from_dem);
+    everything else, geometry, water and heads included, stays the scene's."""
+    return dataclasses.replace(scene, **pile_strength_from_dem(summary),
+                               **pile_sand_from_dem(summary, scene.water_density, scene.water_viscosity))

@@ -19,6 +19,8 @@ import os
 
 import numpy as np
 
+from . import analytical
+
 FRACTIONS = (0.25, 0.5, 0.75)  # probe heads: these fractions of the larger onset rise above the still water
 
 
@@ -69,7 +71,10 @@ def _side(model, summary, columns, width, still, unit_weight, water_density):
         wall, simulated = summary["run_wall_s"] + summary["build_wall_s"], summary["simulated_time_s"]
         bodies = "%d grains (+%d in the base), r = %.1f mm" % (summary["grains"], summary["base_grains"], 1e3 * summary["grain_radius_m"])
         lem = summary["lem_onset_head_m"]
+        sand = summary.get("oedometer") or {}
         extra = {"peak_friction_angle_deg": summary["triaxial"]["peak_friction_angle_deg"],
+                 "oedometric_modulus_Pa": sand.get("oedometric_modulus_Pa"), "porosity": sand.get("porosity"),
+                 "hydraulic_conductivity_m_per_s": sand.get("hydraulic_conductivity_m_per_s"),
                  "dilatancy_angle_deg": summary["triaxial"]["dilatancy_angle_deg"], "grain_diameter_m": 2 * summary["grain_radius_m"],
                  "slice_width_m": width, "ramp_time_s": summary["ramp_time_s"]}
     else:
@@ -83,7 +88,9 @@ def _side(model, summary, columns, width, still, unit_weight, water_density):
                  "inertia_release_head_m": None if release is None else float(np.interp(release, columns["time_s"], head)),
                  "peak_friction_angle_deg": math.degrees(summary["scene"]["friction_angle"]),
                  "dilatancy_angle_deg": math.degrees(summary["scene"]["dilatancy_angle"]),
-                 "strength_from_dem": summary.get("sand_strength_source", "").startswith("DEM")}
+                 "strength_from_dem": summary.get("sand_strength_source", "").startswith("DEM"),
+                 "oedometric_modulus_Pa": analytical.constrained_modulus(summary["scene"]["young_modulus"], summary["scene"]["poisson_ratio"]),
+                 "porosity": summary["scene"]["porosity"], "hydraulic_conductivity_m_per_s": summary["scene"]["hydraulic_conductivity"]}
     conductance = discharge / (head[late] - still)
     return dict(extra, model=model, onset_head_m=onset, sliding_surface=summary.get("sliding_surface"),
                 first_mobilised_zone=summary.get("first_mobilised_zone"), lem_onset_head_m=lem, bodies=bodies, wall_s=wall, simulated_s=simulated,
@@ -159,6 +166,12 @@ def _zone(zone):
     return "%.3f–%.3f; %.3f–%.3f" % tuple(zone["x_range_m"] + zone["z_range_m"])
 
 
+def _sand(side):
+    if side.get("oedometric_modulus_Pa") is None:
+        return "—"
+    return "%.3g, %.3f, %.3g" % (1e-6 * side["oedometric_modulus_Pa"], side["porosity"], side["hydraulic_conductivity_m_per_s"])
+
+
 def _surface(surface):
     if not surface:
         return "—"
@@ -186,8 +199,10 @@ def report(out_dir, result):
         % (_m(mpm["lem_one_cell_onset_head_m"]), _m(mpm["lem_onset_head_m"]), _m(dem["lem_onset_head_m"])),
         "| MPM inertia scaling released at head [m] | %s (α = %s) | — |" % (_m(mpm.get("inertia_release_head_m")), mpm.get("inertia_scale")),
         "| sand strength φ, ψ [°] | %.1f, %.1f (%s) | %.1f, %.1f (drained triaxial on the grains) |"
-        % (mpm["peak_friction_angle_deg"], mpm["dilatancy_angle_deg"], "the DEM grains' triaxial, `--sand-from-dem`" if mpm.get("strength_from_dem") else "scene",
+        % (mpm["peak_friction_angle_deg"], mpm["dilatancy_angle_deg"], "the DEM grains' tests, `--sand-from-dem`" if mpm.get("strength_from_dem") else "scene",
            dem["peak_friction_angle_deg"], dem["dilatancy_angle_deg"]),
+        "| sand's oedometric modulus E_oed [MPa], porosity n, hydraulic conductivity k [m s⁻¹] | %s | %s |"
+        % tuple(_sand(s) for s in (mpm, dem)),
         "| discharge per width and excess head before the onset [m s⁻¹] | %.3g | %.3g |"
         % (mpm["discharge_per_width_per_excess_head_m_per_s"] or math.nan, dem["discharge_per_width_per_excess_head_m_per_s"] or math.nan),
         "| first mobilised zone at the onset (x range; z range) [m] | %s | %s |" % tuple(_zone(s["first_mobilised_zone"]) for s in (mpm, dem)),
@@ -214,13 +229,16 @@ def report(out_dir, result):
     lines += [
         "",
         "Known reasons for differences: the DEM grains are %.0f mm across in a slice %.0f grains wide between smooth walls, where"
-        " the MPM sand is a continuum in the 10 cm flume; PFV's conductance comes from the grains' pores (coarse grains: a far"
-        " larger discharge than the MPM sand's k, which changes the time scale of drainage, not the seepage force at a given"
-        " gradient); the DEM head rise is compressed to %.2f s (quasi-static for the pore pressure, which follows the inflow"
+        " the MPM sand is a continuum in the 10 cm flume; %s; the DEM head rise is compressed to %.2f s (quasi-static for the pore pressure, which follows the inflow"
         " at once in both), the MPM's runs over a laboratory minute with inertia scaling; %s; a grain layer under the"
         " lid and at the walls is more open than the bulk." % (
-            1e3 * dem["grain_diameter_m"], dem["slice_width_m"] / dem["grain_diameter_m"], dem["ramp_time_s"],
-            "the MPM sand has the DEM grains' triaxial strength (φ, φ_r, ψ), but a Mohr–Coulomb continuum with exponential"
+            1e3 * dem["grain_diameter_m"], dem["slice_width_m"] / dem["grain_diameter_m"],
+            "PFV's conductance comes from the pile's own pores, the MPM sand's k from the flow test on a box of the same grains"
+            " (a smooth box's wall layer and a rained pile's packing differ)" if mpm.get("strength_from_dem") else
+            "PFV's conductance comes from the grains' pores (coarse grains: a far larger discharge than the MPM sand's k, which"
+            " changes the time scale of drainage, not the seepage force at a given gradient)", dem["ramp_time_s"],
+            "the MPM sand has the DEM grains' triaxial strength (φ, φ_r, ψ) and oedometric stiffness, but is a Mohr–Coulomb"
+            " continuum with linear elasticity and exponential"
             " softening, where the grains rotate against a rolling resistance" if mpm.get("strength_from_dem") else
             "the DEM sand dilates more (ψ from the triaxial) and its grains rotate against a rolling resistance calibrated to the MPM's φ"),
         "",

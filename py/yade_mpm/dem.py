@@ -82,8 +82,10 @@ def contact_loop(rolling_resistance):
                              [w.Law2_ScGeom6D_CohFrictPhys_CohesionMoment(useIncrementalForm=True, always_use_moment_law=True)])
 
 
-def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle, grain_density, seed, rolling_resistance=None):
-    """Reset the scene; spheres in a width³ box of smooth walls compacted isotropically to `stress`
+def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle, grain_density, seed, rolling_resistance=None,
+                   radius_spread=0.3333):
+    """Reset the scene; spheres (radii uniform within ± `radius_spread` of their mean, relative) in a
+    width³ box of smooth walls compacted isotropically to `stress`
     by particle growth with 3° contact friction and no rolling resistance (a dense packing), then
     given `friction_angle` and `rolling_resistance` (None: no rolling law, see contact_material). Returns the wall ids and the
     TriaxialStressController (still in O.engines)."""
@@ -92,6 +94,7 @@ def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle
     _require("stress", stress, 0 < stress < young, "(0, young) Pa")
     _require("friction_angle", friction_angle, 0 < friction_angle < math.pi / 2, "(0, π/2) rad")
     _require("rolling_resistance", rolling_resistance, rolling_resistance is None or rolling_resistance >= 0, "None or [0, inf)")
+    _require("radius_spread", radius_spread, 0 <= radius_spread < 1, "[0, 1)")
     from yade import pack, utils
     O.reset()
     _pfv_solved[0] = False
@@ -102,7 +105,7 @@ def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle
     O.materials.append(contact_material(young, contact_poisson, 0.0, compaction_rolling, 0.0, "walls"))
     wall_ids = list(O.bodies.append(utils.aabbWalls([lower, upper], thickness=0, material="walls")))
     cloud = pack.SpherePack()
-    cloud.makeCloud(lower, upper, -1, 0.3333, grains, False, 0.95, seed=seed)
+    cloud.makeCloud(lower, upper, -1, radius_spread, grains, False, 0.95, seed=seed)
     O.bodies.append([utils.sphere(center, radius, material="grains") for center, radius in cloud])
     controller = w.TriaxialStressController(maxMultiplier=1 + 2 * stress / young, finalMaxMultiplier=1 + 0.2 * stress / young, thickness=0,
                                             stressMask=7, internalCompaction=True, goal1=-stress, goal2=-stress, goal3=-stress)
@@ -131,14 +134,17 @@ def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle
 
 
 def oedometer_sample(grains=300, width=1.0, stress=10e3, young=1e6, contact_poisson=0.5, friction_angle=math.radians(30),
-                     grain_density=2600.0, seed=1):
+                     grain_density=2600.0, seed=1, rolling_resistance=None, radius_spread=0.3333):
     """Reset the scene and build a sphere assembly in a width³ box, compacted isotropically to
     `stress` [Pa] by particle growth with low friction (3°, for a dense packing), then given its
     contact `friction_angle` [rad] and brought to oedometric equilibrium under the vertical
     `stress` with the top wall free along z. Returns an OedometerSample. `young` [Pa] and
-    `contact_poisson` [-] are the contact stiffness parameters of YADE's FrictMat."""
+    `contact_poisson` [-] are the contact stiffness parameters of YADE's FrictMat; `rolling_resistance`
+    [-] the contacts' etaRoll (contact_material; None: freely rolling spheres); `radius_spread` [-]
+    the radii's relative spread about their mean."""
     from yade import utils
-    wall_ids, _ = _compacted_box(grains, width, stress, young, contact_poisson, friction_angle, grain_density, seed)
+    wall_ids, _ = _compacted_box(grains, width, stress, young, contact_poisson, friction_angle, grain_density, seed, rolling_resistance,
+                                 radius_spread)
     # from here on the top wall carries the load as a force; the time step is the P-wave one
     O.engines = [e for e in O.engines if not isinstance(e, (w.TriaxialStressController, w.GlobalStiffnessTimeStepper))]
     O.dynDt = False
@@ -291,7 +297,7 @@ def consolidate(sample, load, viscosity, times, depths=(0.3, 0.5, 0.7, 0.9), tim
 
 
 def drained_triaxial(grains=300, confinement=10e3, friction_angle=math.radians(30), strain_rate=0.02, final_strain=0.15, width=1.0,
-                     young=1e6, contact_poisson=0.5, grain_density=2600.0, seed=1, rolling_resistance=None):
+                     young=1e6, contact_poisson=0.5, grain_density=2600.0, seed=1, rolling_resistance=None, radius_spread=0.3333):
     """A drained triaxial compression on the same kind of assembly: compacted isotropically to
     `confinement` [Pa], then the top wall moves at the axial `strain_rate` [s⁻¹] (slow enough for
     quasi-static shearing: an inertial number ε̇ d √(ρs/σ3) ≈ 1e-3 here) while the side walls hold σ3,
@@ -300,12 +306,13 @@ def drained_triaxial(grains=300, confinement=10e3, friction_angle=math.radians(3
     the peak of the stress ratio (a moving mean over ±1000 steps), the friction angle over the last 10%
     of the run (towards the critical state), and the mean dilatancy angle from the densest state to the
     peak, sin ψ = −Δεv/(2Δε1 − Δεv) (compression-positive strains). `rolling_resistance` [-]: the
-    contacts' etaRoll (contact_material), None for freely rolling spheres (Cundall–Strack)."""
+    contacts' etaRoll (contact_material), None for freely rolling spheres (Cundall–Strack); `radius_spread`
+    [-] the radii's relative spread about their mean."""
     from yade import utils
     _require("strain_rate", strain_rate, 0 < strain_rate <= 0.1, "(0, 0.1] s⁻¹ (faster is no longer quasi-static)")
     _require("final_strain", final_strain, 0 < final_strain < 0.5, "(0, 0.5)")
     wall_ids, controller = _compacted_box(grains, width, confinement, young, contact_poisson, friction_angle, grain_density, seed,
-                                          rolling_resistance)
+                                          rolling_resistance, radius_spread)
     controller.internalCompaction = False
     for _ in range(40):  # back to isotropic equilibrium with the final friction, walls servo-controlled
         O.run(500, True)

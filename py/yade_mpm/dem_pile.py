@@ -36,6 +36,9 @@ from yade import O, Vector3
 from .dem import XMAX, XMIN, ZMAX, _require, contact_loop, contact_material, switch_flow_on
 
 
+RADIUS_SPREAD = 0.15  # the pile grains' radii: uniform within ± this fraction of their mean [-]
+
+
 @dataclasses.dataclass
 class PileSample:
     """A carved, settled sphere pile in a slice of the flume, ready for the head rise."""
@@ -81,7 +84,7 @@ def _settle(max_steps, grain_ids, unbalanced=0.01, speed=1e-4):
     raise RuntimeError("the pile did not come to rest within %d steps (unbalanced force %.3g)" % (max_steps, utils.unbalancedForce()))
 
 
-def build(scene, gravity, grain_radius=4e-3, radius_spread=0.15, slice_width=0.03, friction_angle=math.radians(30), rolling_resistance=0.05,
+def build(scene, gravity, grain_radius=4e-3, radius_spread=RADIUS_SPREAD, slice_width=0.03, friction_angle=math.radians(30), rolling_resistance=0.05,
           young=2e6, contact_poisson=0.5, wall_friction_angle=0.0, lid_friction_angle=None, lid_pressure=None, grain_lid=False, seed=1, max_steps=200000):
     """Reset the scene and build the pile of `scene` (a yade_mpm.sandpile.SandPileScene with still
     water: PFV models a fully saturated pile) in a slice `slice_width` [m] wide: spheres of mean
@@ -291,14 +294,34 @@ def limit_equilibrium(pile, scene, gravity, flow, friction_angle, dilatancy_angl
                                       min_depth=2 * diameter if min_depth is None else min_depth)
 
 
-def mobilised_zone(pile, positions, fraction=0.1):
-    """Where the motion concentrates: the `fraction` of the free grains displaced most at
-    `positions` (rows of pile.grain_ids), as their start positions' x and z range and centroid [m]."""
-    moved = np.linalg.norm(positions - pile.start_positions, axis=1)
-    chosen = np.argsort(moved)[-max(1, int(round(fraction * len(moved)))):]
-    x, z = pile.start_positions[chosen, 0], pile.start_positions[chosen, 2]
-    return {"x_range_m": [float(x.min()), float(x.max())], "z_range_m": [float(z.min()), float(z.max())],
-            "centroid_m": [float(x.mean()), float(z.mean())], "least_displacement_m": float(moved[chosen].min()), "grains": int(len(chosen))}
+def sand_properties(scene, gravity, grain_radius, stress, young, contact_friction_angle, rolling_resistance, radius_spread=RADIUS_SPREAD,
+                    grains=1000):
+    """The pile grains' continuum stiffness and permeability, measured on a box of the same grains
+    (dem.oedometer_sample: `grains` spheres with the pile's radius spread (1000: the looser grain layer
+    along the box's smooth walls weighs less than in a box of 300, which gave n 0.452 instead of 0.431
+    and κ 1.23× larger at the pile's defaults), contact law and rolling
+    resistance, compacted to the vertical `stress` [Pa], the pile's stress level): the oedometric
+    modulus E_oed and K0 of a ±10% drained load cycle (dem.measure_oedometric_modulus), the porosity,
+    and PFV's permeability in a steady flow test with the scene's water (dem.measure_permeability).
+    The box's grains have the size its compaction gives them; PFV's conductances are geometric
+    (Poiseuille throats: κ scales as length²) and the packing depends on the contacts' stiffness
+    relative to the stress, not on the size, so κ is brought to the pile's `grain_radius` [m] as
+    κ (r_pile / r_box)². Returns a dict for the pile's summary (also the MPM sand's calibration,
+    calibrate.pile_scene_from_dem); k = κ ρw |g| / μw."""
+    from . import dem
+    sample = dem.oedometer_sample(grains=grains, stress=stress, young=young, friction_angle=contact_friction_angle,
+                                  grain_density=scene.grain_density, rolling_resistance=rolling_resistance, radius_spread=radius_spread)
+    modulus = dem.measure_oedometric_modulus(sample)
+    flow = dem.measure_permeability(sample, viscosity=scene.water_viscosity)
+    radii = [b.shape.radius for b in O.bodies if isinstance(b.shape, w.Sphere)]
+    box_radius = sum(radii) / len(radii)
+    permeability = flow["intrinsic_permeability"] * (grain_radius / box_radius) ** 2
+    return {"grains": grains, "vertical_stress_Pa": stress, "oedometric_modulus_Pa": modulus["oedometric_modulus"],
+            "unloading_modulus_Pa": modulus["unloading_modulus"], "lateral_ratio": modulus["lateral_ratio"],
+            "poisson_ratio": modulus["poisson_ratio"], "porosity": modulus["porosity"], "box_mean_radius_m": box_radius,
+            "grain_radius_m": grain_radius, "flow_test_mismatch": abs(flow["inflow"] - flow["outflow"]) / abs(flow["inflow"]),
+            "intrinsic_permeability_m2": permeability,
+            "hydraulic_conductivity_m_per_s": permeability * scene.water_density * float(np.linalg.norm(gravity)) / scene.water_viscosity}
 
 
 def summary(pile, scene, record):
@@ -321,7 +344,7 @@ def summary(pile, scene, record):
         "onset_head_m": record["onset_head"], "onset_time_s": record["onset_time"],
         "toe_displacement_m": record["toe_displacement"][-1], "face_displacement_m": record["face_displacement"][-1],
         "max_displacement_m": record["max_displacement"][-1],
-        "first_mobilised_zone": None if onset is None else mobilised_zone(pile, record["positions"][onset]),
+        "first_mobilised_zone": None if onset is None else analysis.mobilised_zone(pile.start_positions, record["positions"][onset]),
         "sliding_surface": sliding,
         "inflow_before_onset_m3_per_s": inflow, "outflow_before_onset_m3_per_s": outflow,
         "flux_mismatch_before_onset": abs(inflow - outflow) / max(abs(inflow), 1e-300),
@@ -380,12 +403,13 @@ DEFAULT_CASE = {"grain_radius": 0.004, "ramp_time": 4.0}  # about 1400 grains
 
 
 def run_case(out_dir, gravity, quick=False, control=False, ramp_time=None, grain_radius=None, slice_width=0.03, rolling_resistance=0.05,
-             young=2e6, contact_friction_angle=math.radians(30), scene=None, grain_lid=False):
+             young=2e6, contact_friction_angle=math.radians(30), scene=None, grain_lid=False, radius_spread=RADIUS_SPREAD):
     """The whole DEM pile case, as examples/dem/sandpile.py and `python3 -m yade_mpm.compare sandpile`
     run it: the MPM's submerged, lidded pile (`scene`, default yade_mpm.sandpile.SUBMERGED with the
     crest lid) with its head history compressed to a rise of `ramp_time` [s] (settling 5% and holding
     25% of it; `control`: no rise); a drained triaxial test on the same grains (300, at the crest's
-    mid-depth effective stress) for the sand's φ and ψ; the pile built and the head raised, with
+    mid-depth effective stress) for the sand's φ and ψ, and an oedometer and flow test on them at
+    the same stress for E_oed, K0, n and κ (sand_properties); the pile built and the head raised, with
     Bishop's factor every other record. Writes out_dir/summary.json, time_series.csv and
     sandpile_dem.png; returns the summary."""
     import csv
@@ -404,9 +428,11 @@ def run_case(out_dir, gravity, quick=False, control=False, ramp_time=None, grain
     os.makedirs(out_dir, exist_ok=True)
     confinement = (scene.grain_density - scene.water_density) * (1 - scene.porosity) * g * 0.5 * scene.pile_height
     triaxial = dem.drained_triaxial(grains=300, confinement=confinement, friction_angle=contact_friction_angle, young=young,
-                                    grain_density=scene.grain_density, final_strain=0.1, rolling_resistance=rolling_resistance)
+                                    grain_density=scene.grain_density, final_strain=0.1, rolling_resistance=rolling_resistance,
+                                    radius_spread=radius_spread)
     strength = calibrate.strength_from_triaxial(triaxial)
-    pile = build(scene, gravity, grain_radius=radius, slice_width=slice_width, friction_angle=contact_friction_angle,
+    sand = sand_properties(scene, gravity, radius, confinement, young, contact_friction_angle, rolling_resistance, radius_spread)
+    pile = build(scene, gravity, grain_radius=radius, radius_spread=radius_spread, slice_width=slice_width, friction_angle=contact_friction_angle,
                  rolling_resistance=rolling_resistance, young=young, grain_lid=grain_lid)
     lem = {"heads_m": [], "factors": []}
 
@@ -433,7 +459,8 @@ def run_case(out_dir, gravity, quick=False, control=False, ramp_time=None, grain
                   contact_young_Pa=young, gravity_m_per_s2=list(gravity), probe_points=scene.probe_points(slice_width),
                   triaxial={"grains": 300, "confinement_Pa": confinement, "peak_friction_angle_deg": math.degrees(strength["frictionAngle"]),
                             "residual_friction_angle_deg": math.degrees(strength["residualFrictionAngle"]),
-                            "dilatancy_angle_deg": math.degrees(strength["dilatancyAngle"])},
+                            "dilatancy_angle_deg": math.degrees(strength["dilatancyAngle"]), "radius_spread": radius_spread},
+                  oedometer=sand,
                   limit_equilibrium=dict(lem, method="Bishop simplified, critical circle at least 2 grain diameters deep, Davis (1968) strength"),
                   lem_onset_head_m=analysis.falls_below(lem["heads_m"], lem["factors"]),
                   peak_memory_MiB=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)  # of this process (YADE included)

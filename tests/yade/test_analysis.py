@@ -49,6 +49,39 @@ def test_runout_profile_and_mobilised_volume_of_a_shifted_wedge():
     assert volume == pytest.approx(sliding.sum() * spacing ** 3) and fraction == pytest.approx(sliding.mean())
 
 
+def test_first_mobilised_zone_is_the_block_that_moved_most():
+    """A wedge of points where a block near the toe (0.22 < x < 0.26 m, z < 0.03 m: 10% of the
+    points or fewer) moves 5 mm and the rest creeps 0.1–0.5 mm: the tenth displaced most holds the
+    whole block, and its reference range is the block's (the rest fills the tenth from the next
+    fastest); a fraction outside (0, 1] is refused by name."""
+    spacing = 0.005
+    x, z = np.meshgrid(np.arange(0, 0.3, spacing) + spacing / 2, np.arange(0, 0.12, spacing) + spacing / 2, indexing="ij")
+    keep = z < 0.12 - np.clip(x - 0.1, 0, None) * np.tan(np.radians(30))
+    start = np.stack([x[keep], np.zeros(keep.sum()), z[keep]], axis=1)
+    block = (start[:, 0] > 0.22) & (start[:, 0] < 0.26) & (start[:, 2] < 0.03)
+    moved = start.copy()
+    moved[:, 0] += 1e-4 + 4e-4 * start[:, 0] / 0.3  # creep, at most 0.5 mm
+    moved[block, 0] += 5e-3
+    zone = analysis.mobilised_zone(start, moved, fraction=block.mean())
+    assert zone["count"] == block.sum() and zone["least_displacement_m"] > 5e-3
+    assert zone["x_range_m"] == pytest.approx([start[block, 0].min(), start[block, 0].max()])
+    assert zone["z_range_m"] == pytest.approx([start[block, 2].min(), start[block, 2].max()])
+    wider = analysis.mobilised_zone(start, moved, fraction=0.1)
+    assert wider["count"] == round(0.1 * len(start)) and wider["x_range_m"][1] >= start[block, 0].max()
+    with pytest.raises(ValueError, match="fraction"):
+        analysis.mobilised_zone(start, moved, fraction=0.0)
+
+
+def test_falls_below_is_the_first_load_under_the_level():
+    """Factors 1.2, –, 1.1, 0.9, 0.8 at loads 0–4 cross 1 at 2.5 (linear between the records, the
+    None entry skipped), a linear fall from 1.2 to 0.8 at 2.0; one that starts below 1 (a slope short of equilibrium at rest) gives the
+    first load even when it later rises above 1 and falls again; one that stays above gives None."""
+    assert analysis.falls_below([0, 1, 2, 3, 4], [1.2, None, 1.1, 0.9, 0.8]) == pytest.approx(2.5)
+    assert analysis.falls_below([0, 1, 2, 3, 4], [1.2, 1.1, 1.0, 0.9, 0.8]) == pytest.approx(2.0)
+    assert analysis.falls_below([0.15, 0.16, 0.17, 0.18], [0.98, 1.7, 0.5, 0.2]) == 0.15
+    assert analysis.falls_below([0, 1, 2], [1.3, 1.2, 1.1]) is None
+
+
 def test_compliance_onset_is_where_the_load_displacement_curve_softens_tenfold():
     """Elastic u = c (H − H0) up to H_y, then a parabola whose slope grows as c + 2a(H − H_y):
     the compliance passes 10 c where 2a(H − H_y) = 9 c. The onset is the first increment whose

@@ -10,7 +10,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from yade_mpm import calibrate, compare_pile, sandpile
+from yade_mpm import analytical, calibrate, compare_pile, sandpile
 
 G = 9.81
 STILL = 0.15
@@ -105,21 +105,40 @@ def test_the_command_writes_the_report_and_refuses_a_scene_pfv_cannot_model(runs
 DEM_RUN = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "doc", "compare", "sandpile", "dem-run")
 
 
-def test_the_mpm_sand_takes_the_dem_grains_strength_and_nothing_else():
+def test_the_mpm_sand_takes_the_dem_grains_properties_and_nothing_else():
     """calibrate.pile_scene_from_dem (the example's --sand-from-dem): the stored DEM pile's triaxial
     angles become the MPM scene's φ, φ_r, ψ and the base's δ = φ to round-off (degrees to radians);
-    geometry, heads, stiffness and permeability stay the scene's."""
+    its oedometer and flow test on the same grains become E and ν with the grains' E_oed and K0 (the
+    constrained modulus of isotropic elasticity, ν/(1 − ν) = K0), their porosity, and the hydraulic
+    conductivity whose intrinsic permeability is the grains' κ; geometry, water and heads stay the scene's."""
     with open(os.path.join(DEM_RUN, "summary.json")) as f:
         summary = json.load(f)
-    triaxial = summary["triaxial"]
+    triaxial, sand = summary["triaxial"], summary["oedometer"]
     scene = calibrate.pile_scene_from_dem(sandpile.SUBMERGED, summary)
     assert math.degrees(scene.friction_angle) == pytest.approx(triaxial["peak_friction_angle_deg"], rel=1e-14)
     assert math.degrees(scene.residual_friction_angle) == pytest.approx(triaxial["residual_friction_angle_deg"], rel=1e-14)
     assert math.degrees(scene.dilatancy_angle) == pytest.approx(triaxial["dilatancy_angle_deg"], rel=1e-14)
     assert scene.base_friction_angle == scene.friction_angle
-    unchanged = set(sandpile.SandPileScene.__dataclass_fields__) - {"friction_angle", "residual_friction_angle", "dilatancy_angle", "base_friction_angle"}
+    assert analytical.constrained_modulus(scene.young_modulus, scene.poisson_ratio) == pytest.approx(sand["oedometric_modulus_Pa"], rel=1e-12)
+    assert scene.poisson_ratio / (1 - scene.poisson_ratio) == pytest.approx(sand["lateral_ratio"], rel=1e-12)
+    assert scene.porosity == sand["porosity"]
+    assert scene.intrinsic_permeability(summary["gravity_m_per_s2"]) == pytest.approx(sand["intrinsic_permeability_m2"], rel=1e-12)
+    changed = {"friction_angle", "residual_friction_angle", "dilatancy_angle", "base_friction_angle", "young_modulus", "poisson_ratio",
+               "porosity", "hydraulic_conductivity"}
+    unchanged = set(sandpile.SandPileScene.__dataclass_fields__) - changed
     assert all(getattr(scene, k) == getattr(sandpile.SUBMERGED, k) for k in unchanged)
     scene.validate()
+
+
+def test_a_dem_summary_without_the_grains_oedometer_is_refused_naming_the_key():
+    with open(os.path.join(DEM_RUN, "summary.json")) as f:
+        summary = json.load(f)
+    older = {k: v for k, v in summary.items() if k != "oedometer"}  # a run made before the grains' oedometer test
+    with pytest.raises(ValueError, match=r"summary\['oedometer'\] is missing.*re-run examples/dem/sandpile.py"):
+        calibrate.pile_scene_from_dem(sandpile.SUBMERGED, older)
+    bad = dict(summary, oedometer=dict(summary["oedometer"], porosity=1.2))
+    with pytest.raises(ValueError, match=r"summary\['oedometer'\]\['porosity'\] = 1.2 is outside the valid range \(0, 1\)"):
+        calibrate.pile_scene_from_dem(sandpile.SUBMERGED, bad)
 
 
 @pytest.mark.parametrize("triaxial, message", [(None, r"summary\['triaxial'\] is missing"),

@@ -189,8 +189,8 @@ def test_bad_input_is_refused_before_any_work():
 
 def test_the_example_writes_its_summary_series_and_figure(tmp_path):
     """examples/dem/sandpile.py --quick --control: the pile stands (no onset), Bishop's F stays at the
-    infinite slope's (within 0.2, as at rest above), and the summary, the time series and the figure
-    are written."""
+    infinite slope's (within 0.2, as at rest above), the grains' oedometer and flow test give
+    physical E_oed, K0, n and κ, and the summary, the time series and the figure are written."""
     import json
     root = os.path.join(os.path.dirname(__file__), "..", "..")
     result = subprocess.run(["yade-double", "-n", "-x", os.path.join(root, "examples", "dem", "sandpile.py"), "--quick", "--control",
@@ -205,6 +205,15 @@ def test_the_example_writes_its_summary_series_and_figure(tmp_path):
     assert 30 < triaxial["peak_friction_angle_deg"] < 42
     infinite = _infinite_slope_factor(math.radians(triaxial["peak_friction_angle_deg"]), math.radians(triaxial["dilatancy_angle_deg"]))
     assert all(f == pytest.approx(infinite, abs=0.2) for f in summary["limit_equilibrium"]["factors"])
+    # the pile grains' oedometer and flow test (sand_properties): PFV's fluid is incompressible, so
+    # what enters the box leaves it; n is a dense random packing's; K0 of an elastic granular skeleton
+    # lies in (0, 1); and κ is the Kozeny–Carman value d² n³/(180 (1 − n)²) (Carman 1937) within a
+    # factor 2 (PFV's throats are not Carman's tubes; measured 1.2× at the default grains)
+    sand = summary["oedometer"]
+    assert sand["flow_test_mismatch"] < 1e-9 and 0.33 < sand["porosity"] < 0.48 and 0 < sand["lateral_ratio"] < 1
+    assert sand["oedometric_modulus_Pa"] > 0 and sand["grain_radius_m"] == summary["grain_radius_m"]
+    n, d = sand["porosity"], 2 * sand["grain_radius_m"]
+    assert 0.5 < sand["intrinsic_permeability_m2"] / (d ** 2 * n ** 3 / (180 * (1 - n) ** 2)) < 2
     rows = open(tmp_path / "time_series.csv").read().splitlines()
     assert rows[0].startswith("time_s,head_m") and len(rows) > 10
     assert (tmp_path / "sandpile_dem.png").stat().st_size > 10000

@@ -166,3 +166,12 @@ def test_summary_reports_onset_runout_and_water_that_really_flowed(quick_run):
     for found in (onset, summary["kinetic_onset"]):
         assert found is None or found["time_s"] >= summary["scene"]["settle_time"]
     assert summary["onset_head_m"] == (None if onset is None else onset["head_m"])
+    # the first mobilised zone (the tenth of the points displaced most since the rise, at the onset)
+    # exists exactly when an onset does, and lies inside the pile where those points stood
+    zone = summary["first_mobilised_zone"]
+    assert (zone is None) == (onset is None)
+    if zone is not None:
+        scene = summary["scene"]
+        toe = scene["crest_length"] + scene["pile_height"] / math.tan(scene["slope_angle"])
+        assert 0 <= zone["x_range_m"][0] <= zone["x_range_m"][1] <= toe and 0 <= zone["z_range_m"][0] <= zone["z_range_m"][1] <= scene["pile_height"]
+        assert zone["count"] == round(0.1 * summary["points_per_phase_initial"])

@@ -52,11 +52,15 @@ def test_submerged_pile_water_balance_closes(submerged_run):
 @pytest.mark.parametrize("flags, message", [(["--crest-lid", "--lid-friction", "-0.1"], "--lid-friction must be ≥ 0"),
                                             (["--lid-friction", "0.5"], "--lid-friction 0.5 needs --crest-lid"),
                                             (["--side-wall-friction", "-1"], "--side-wall-friction must be ≥ 0"),
-                                            (["--sand-from-dem", "no-such-run"], "--sand-from-dem 'no-such-run': no summary.json there")])
+                                            (["--sand-from-dem", "no-such-run"], "--sand-from-dem 'no-such-run': no summary.json there"),
+                                            (["--sand-from-dem", os.path.join(ROOT, "doc", "compare", "sandpile", "dem-run"), "--inertia-scale", "100"],
+                                             "--inertia-scale = 100.0 is outside the valid range [1, ")])
 def test_lid_friction_is_refused_before_any_work(tmp_path, flags, message):
     """A negative Coulomb coefficient has no meaning, and a lid friction without a lid would be
     silently ignored: both stop at once with the flag's name, value and what is valid; so does a
-    DEM run directory that holds no summary to take the sand from."""
+    DEM run directory that holds no summary to take the sand from, and an inertia scaling under which
+    the coarse DEM grains' drag relaxation (α ρsat κ/μw ≈ 20 s at α = 100) would lag the pore pressure
+    behind a 60 s head rise."""
     done = subprocess.run(["yade-double", "-n", "-x", os.path.join(ROOT, "examples", "sandpile", "sandpile.py"), "--quick", "--submerged",
                            "--scheme", "semi-implicit", "--out", str(tmp_path)] + flags,
                           capture_output=True, text=True, timeout=120, env=dict(os.environ, HOME=str(tmp_path)), stdin=subprocess.DEVNULL)
