@@ -85,6 +85,9 @@ parser.add_argument("--sand-from-dem", metavar="DIR",
                     help="take the sand (φ, φ_r, ψ, base δ = φ; E and ν from E_oed and K0; n; k) from a DEM + PFV pile run's "
                          "DIR/summary.json (examples/dem/sandpile.py: the triaxial, oedometer and flow tests on its grains; "
                          "yade_mpm.calibrate.pile_scene_from_dem)")
+parser.add_argument("--dem-strength-only", action="store_true",
+                    help="with --sand-from-dem: take only the strength (φ, φ_r, ψ, δ = φ); stiffness, porosity and permeability "
+                         "stay the scene's")
 args = parser.parse_args(sys.argv[1:])
 if not args.lid_friction >= 0:
     raise SystemExit("--lid-friction must be ≥ 0 (a Coulomb coefficient); got %r" % args.lid_friction)
@@ -110,8 +113,11 @@ if args.sand_from_dem is not None:
     if not os.path.isfile(dem_summary_path):
         raise SystemExit("--sand-from-dem %r: no summary.json there (a run of examples/dem/sandpile.py writes it)" % args.sand_from_dem)
     with open(dem_summary_path) as f:
-        SCENE = calibrate.pile_scene_from_dem(SCENE, json.load(f))
-    SAND_SOURCE = "DEM pile's triaxial, oedometer and flow tests on its grains, " + dem_summary_path
+        SCENE = calibrate.pile_scene_from_dem(SCENE, json.load(f), strength_only=args.dem_strength_only)
+    SAND_SOURCE = ("DEM pile's triaxial test on its grains (strength only), " if args.dem_strength_only else
+                   "DEM pile's triaxial, oedometer and flow tests on its grains, ") + dem_summary_path
+elif args.dem_strength_only:
+    raise SystemExit("--dem-strength-only needs --sand-from-dem DIR (there is no DEM sand to take the strength from)")
 SEMI_IMPLICIT = args.scheme == "semi-implicit"
 GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
 G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]

@@ -124,9 +124,11 @@ def pile_sand_from_dem(summary, water_density, water_viscosity):
             "hydraulic_conductivity": values["intrinsic_permeability_m2"] * water_density * math.hypot(*gravity) / water_viscosity}
 
 
-def pile_scene_from_dem(scene, summary):
+def pile_scene_from_dem(scene, summary, strength_only=False):
     """`scene` (a sandpile.SandPileScene) with the sand of the DEM pile's grains: their strength
-    (pile_strength_from_dem) and their stiffness, porosity and permeability (pile_sand_from_dem);
-    everything else, geometry, water and heads included, stays the scene's."""
-    return dataclasses.replace(scene, **pile_strength_from_dem(summary),
-                               **pile_sand_from_dem(summary, scene.water_density, scene.water_viscosity))
+    (pile_strength_from_dem) and, unless `strength_only`, their stiffness, porosity and permeability
+    (pile_sand_from_dem); everything else, geometry, water and heads included, stays the scene's."""
+    strength = pile_strength_from_dem(summary)
+    if strength_only:
+        return dataclasses.replace(scene, **strength)
+    return dataclasses.replace(scene, **strength, **pile_sand_from_dem(summary, scene.water_density, scene.water_viscosity))

@@ -2,6 +2,7 @@
 runs written here with known series, so that every number of the report can be checked against its
 inputs (issue 16)."""
 import csv
+import dataclasses
 import json
 import math
 import os
@@ -128,6 +129,9 @@ def test_the_mpm_sand_takes_the_dem_grains_properties_and_nothing_else():
     unchanged = set(sandpile.SandPileScene.__dataclass_fields__) - changed
     assert all(getattr(scene, k) == getattr(sandpile.SUBMERGED, k) for k in unchanged)
     scene.validate()
+    strength = calibrate.pile_scene_from_dem(sandpile.SUBMERGED, summary, strength_only=True)
+    assert strength == dataclasses.replace(scene, **{k: getattr(sandpile.SUBMERGED, k) for k in
+                                                     ("young_modulus", "poisson_ratio", "porosity", "hydraulic_conductivity")})
 
 
 def test_a_dem_summary_without_the_grains_oedometer_is_refused_naming_the_key():

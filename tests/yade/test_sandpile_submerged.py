@@ -53,6 +53,7 @@ def test_submerged_pile_water_balance_closes(submerged_run):
                                             (["--lid-friction", "0.5"], "--lid-friction 0.5 needs --crest-lid"),
                                             (["--side-wall-friction", "-1"], "--side-wall-friction must be ≥ 0"),
                                             (["--sand-from-dem", "no-such-run"], "--sand-from-dem 'no-such-run': no summary.json there"),
+                                            (["--dem-strength-only"], "--dem-strength-only needs --sand-from-dem DIR"),
                                             (["--sand-from-dem", os.path.join(ROOT, "doc", "compare", "sandpile", "dem-run"), "--inertia-scale", "100"],
                                              "--inertia-scale = 100.0 is outside the valid range [1, ")])
 def test_lid_friction_is_refused_before_any_work(tmp_path, flags, message):
