@@ -202,7 +202,8 @@ def test_the_example_writes_its_summary_series_and_figure(tmp_path):
     assert summary["max_displacement_m"] < 0.1 * summary["grain_radius_m"]
     # and Bishop's F stays at the infinite slope's of the measured strength (no excess pressure)
     triaxial = summary["triaxial"]
-    assert 30 < triaxial["peak_friction_angle_deg"] < 42
+    # above freely rolling spheres' 27–28° (the pile's ±15% grains read 31.7° at 4 mm, doc/dem-comparison.md)
+    assert 29 < triaxial["peak_friction_angle_deg"] < 42
     infinite = _infinite_slope_factor(math.radians(triaxial["peak_friction_angle_deg"]), math.radians(triaxial["dilatancy_angle_deg"]))
     assert all(f == pytest.approx(infinite, abs=0.2) for f in summary["limit_equilibrium"]["factors"])
     # the pile grains' oedometer and flow test (sand_properties): PFV's fluid is incompressible, so
