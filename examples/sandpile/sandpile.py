@@ -189,8 +189,9 @@ engine = MpmTwoPhaseEngine(
     inertiaScaleRelease=args.inertia_release,
     stillWaterLevel=SCENE.still_water_level if SUBMERGED else float("-inf"),  # pore pressures are excess ones when submerged
     #            xMin (inflow)  xMax      yMin (front)   yMax (rear)    zMin (base)    zMax
-    # zMax: open, or with a crest lid the domain's top at the crest: a Coulomb contact (pushes, never
-    # pulls; μ = --lid-friction, smooth by default) that the water cannot cross
+    # zMax: open, or with a crest lid the domain's top at the crest: a Coulomb contact (μ = --lid-friction,
+    # smooth by default) that the water cannot cross, so on the semi-implicit step it also holds the
+    # crest up (theory.md eq. 2.6b)
     # yMin/yMax: smooth (plane strain) or, with --side-wall-friction μ > 0, a Coulomb contact like the base's
     solidWalls=("slip",        "free",   SIDE_WALL,     SIDE_WALL,     args.base,     "frictional" if SCENE.crest_lid else "free"),
     wallFriction=(0,           0,        args.side_wall_friction, args.side_wall_friction,

@@ -115,7 +115,7 @@ namespace stages {
 
 	void integrateNodalMomentum(GridFields& fields, const ConstrainedNodes& constrained, Real dt, DragScheme drag, Real solidMassTolerance,
 	                            Real waterMassTolerance, const std::vector<char>* suctionHolding, bool friction,
-	                            std::vector<std::array<bool, 3>>* heldSolid)
+	                            std::vector<std::array<bool, 3>>* heldSolid, bool holdContactsUnderImpermeableWalls)
 	{
 		const std::size_t nodes = fields.solid.size();
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
@@ -163,14 +163,16 @@ namespace stages {
 			const bool holding = hasS && hasW && suctionHolding && (*suctionHolding)[i];
 			// A frictional wall is a contact (eq. 2.6): released only where N' ≤ 0 and the grains
 			// move off the wall; a node pulled off but carried towards the wall by its momentum
-			// stays held (else it would pass the wall)
+			// stays held (else it would pass the wall). Under a face the water cannot cross, the
+			// semi-implicit step holds it both ways (eq. 2.6b: a released node would be an undrained
+			// face over a free skeleton, where its projection is unstable)
 			NodeConstraint      active = nc;
 			std::array<Real, 3> normalForce { 0, 0, 0 };
 			if (hasS)
 				for (int d = 0; d < 3; ++d) {
 					if (nc.inward[d] == 0) continue;
 					normalForce[d]  = contactNormalForce(fields, i, nc, d, hasW);
-					active.solid[d] = normalForce[d] > 0 || nc.inward[d] * vsNew[d] < 0;
+					active.solid[d] = normalForce[d] > 0 || nc.inward[d] * vsNew[d] < 0 || (holdContactsUnderImpermeableWalls && nc.water[d]);
 					normalForce[d]  = std::max<Real>(0, normalForce[d]);
 				}
 			if (heldSolid) (*heldSolid)[c] = active.solid;

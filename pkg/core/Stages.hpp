@@ -140,9 +140,12 @@ namespace stages {
 	// `friction` false leaves the Coulomb step of frictional walls to applyWallFriction (the
 	// semi-implicit step applies it once, after the pressure correction); `heldSolid`, when given,
 	// receives per constrained node the solid components held this step (contacts may release).
+	// `holdContactsUnderImpermeableWalls`: a frictional contact whose face is also impermeable to the
+	// water is not released (theory.md eq. 2.6b; the semi-implicit step).
 	void integrateNodalMomentum(GridFields& fields, const ConstrainedNodes& constrained, Real dt, DragScheme drag,
 	                            Real solidMassTolerance, Real waterMassTolerance, const std::vector<char>* suctionHolding = nullptr,
-	                            bool friction = true, std::vector<std::array<bool, 3>>* heldSolid = nullptr);
+	                            bool friction = true, std::vector<std::array<bool, 3>>* heldSolid = nullptr,
+	                            bool holdContactsUnderImpermeableWalls = false);
 
 	// The rigid plate (theory.md eq. 2.9), after integrateNodalMomentum: V from the momentum of
 	// both phases at its nodes and every force on them, V = Σ (m^s v^s + m^w v^w + Δt f^m)·e / M, set

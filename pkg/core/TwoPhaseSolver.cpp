@@ -470,7 +470,7 @@ void TwoPhaseSolver::integrateMomentum(Real dt, bool wet, bool semiImplicit)
 	// the semi-implicit step takes the drag implicitly (its corrector is the implicit 2×2 system, and
 	// its time step knows no drag limit) and applies the wall friction once, after the corrector
 	integrateNodalMomentum(fields_, constrained_, dt, semiImplicit ? DragScheme::SemiImplicit : settings_.drag, solidMassTolerance_, waterMassTolerance_,
-	                       holdSuction ? &suctionHolding_ : nullptr, !semiImplicit, &heldSolid_);
+	                       holdSuction ? &suctionHolding_ : nullptr, !semiImplicit, &heldSolid_, semiImplicit);
 	if (!constrained_.plate.empty()) moveRigidPlate(fields_, constrained_, dt, solidMassTolerance_, waterMassTolerance_, plate_); // eq. 2.9
 }
 

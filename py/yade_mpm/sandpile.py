@@ -61,7 +61,7 @@ class SandPileScene:
     # from it, and the model solves the excess pore pressure (engine stillWaterLevel, theory.md eq. 1.9).
     still_water_level: float = None
     # An impermeable, smooth lid on the crest [-]: the model's top at the crest height (domain_height), a contact that
-    # holds the crest down (never pulls it up) and keeps the water from leaving through it, so that
+    # holds the crest down (on the semi-implicit step also up: theory.md eq. 2.6b) and keeps the water from leaving through it, so that
     # the seepage leaves through the slope (a submerged crest next to the inflow face is a piping exit
     # otherwise: the face's excess head meets the surface's p = 0 across one cell).
     crest_lid: bool = False

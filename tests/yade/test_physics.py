@@ -487,3 +487,39 @@ def test_soil_above_the_still_water_is_refused_naming_the_attribute():
     assert O.engines[0].stepsDone == 0 and np.array_equal(solid.pos, start)
     with pytest.raises(ValueError, match="still_water_level"):
         submerged_column(height=0.275, level=0.2)
+
+
+
+@pytest.mark.parametrize("lid", ["frictional", "slip"])
+def test_submerged_block_under_an_impermeable_lid_stays_at_rest(lid):
+    """A saturated, submerged block (excess pore pressure, theory.md eq. 1.9) filling a box up to an
+    impermeable lid, drained through one side face at the still water's head, under its buoyant
+    weight at rest: nothing drives any flow or motion, so the excess pressure stays 0 and the points
+    at rest, to round-off, under a smooth (slip) lid and under a Coulomb contact lid (the sand pile's
+    crest lid, eq. 2.6). The contact carries no load at the block's unloaded top; released there, it
+    was an undrained face over a free skeleton, and the semi-implicit step's pressure rang at
+    ±100–250 Pa with speeds near 1 mm/s (the pile's crest points passed the lid): the contact is held
+    both ways under a face the water cannot cross (eq. 2.6b)."""
+    cell, spacing, still = 0.02, 0.01, 0.15
+    size = np.array([0.2, 0.04, 0.12])
+    axes = [np.arange(spacing / 2, length, spacing) for length in size]
+    positions = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    # cohesionless sand: at the unloaded top it yields under any disturbance, which is what finds a wrong pressure there
+    soil = w.MpmSoilMat(density=2650, youngModulus=20e6, poissonRatio=0.3, porosity=0.4, intrinsicPermeability=1e-10, model="MohrCoulomb",
+                        frictionAngle=np.radians(35), dilatancyAngle=np.radians(5), cohesion=0.0)
+    water = w.MpmWaterMat(density=1000, bulkModulus=2.2e8, viscosity=1e-3)
+    O.materials.append([soil, water])
+    solid, fluid = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=G, surface=np.full(len(positions), size[2]),
+                                             still_water_level=still, lateral_earth_pressure=0.5)
+    O.bodies.append([solid, fluid])
+    no_table = float("-inf")
+    engine = w.MpmTwoPhaseEngine(label="mpm", gravity=G, domainMin=(0, 0, 0), domainMax=tuple(size), cellSize=cell, stillWaterLevel=still,
+                                 solidWalls=("slip",) * 4 + ("frictional", lid), wallFriction=(0, 0, 0, 0, 0.7, 0.7 if lid == "frictional" else 0),
+                                 waterWalls=("drained",) + ("impermeable",) * 5, drainedWaterTable=(still,) + (no_table,) * 5,
+                                 waterInflow=(True,) + (False,) * 5, removeFreeWater=True, freeSurfaceThreshold=0.75)
+    O.engines = [engine]
+    O.dt = 0.01
+    O.run(25, True)  # 0.25 s
+    unit = 1000 * 9.81 * size[2]  # γw H [Pa]
+    assert np.abs(fluid.shape.porePressure).max() < 1e-9 * unit
+    assert np.linalg.norm(solid.shape.vel, axis=1).max() < 1e-12 and np.linalg.norm(fluid.shape.vel, axis=1).max() < 1e-12
