@@ -89,6 +89,7 @@ def _side(model, summary, columns, width, still, unit_weight, water_density):
                  "peak_friction_angle_deg": math.degrees(summary["scene"]["friction_angle"]),
                  "dilatancy_angle_deg": math.degrees(summary["scene"]["dilatancy_angle"]),
                  "strength_from_dem": summary.get("sand_strength_source", "").startswith("DEM"),
+                 "only_strength_from_dem": "(strength only)" in summary.get("sand_strength_source", ""),
                  "oedometric_modulus_Pa": analytical.constrained_modulus(summary["scene"]["young_modulus"], summary["scene"]["poisson_ratio"]),
                  "porosity": summary["scene"]["porosity"], "hydraulic_conductivity_m_per_s": summary["scene"]["hydraulic_conductivity"]}
     conductance = discharge / (head[late] - still)
@@ -166,6 +167,14 @@ def _zone(zone):
     return "%.3f–%.3f; %.3f–%.3f" % tuple(zone["x_range_m"] + zone["z_range_m"])
 
 
+def _strength_source(side):
+    if not side.get("strength_from_dem"):
+        return "scene"
+    if side.get("only_strength_from_dem"):
+        return "the DEM grains' triaxial, `--sand-from-dem --dem-strength-only`"
+    return "the DEM grains' tests, `--sand-from-dem`"
+
+
 def _sand(side):
     if side.get("oedometric_modulus_Pa") is None:
         return "—"
@@ -199,7 +208,7 @@ def report(out_dir, result):
         % (_m(mpm["lem_one_cell_onset_head_m"]), _m(mpm["lem_onset_head_m"]), _m(dem["lem_onset_head_m"])),
         "| MPM inertia scaling released at head [m] | %s (α = %s) | — |" % (_m(mpm.get("inertia_release_head_m")), mpm.get("inertia_scale")),
         "| sand strength φ, ψ [°] | %.1f, %.1f (%s) | %.1f, %.1f (drained triaxial on the grains) |"
-        % (mpm["peak_friction_angle_deg"], mpm["dilatancy_angle_deg"], "the DEM grains' tests, `--sand-from-dem`" if mpm.get("strength_from_dem") else "scene",
+        % (mpm["peak_friction_angle_deg"], mpm["dilatancy_angle_deg"], _strength_source(mpm),
            dem["peak_friction_angle_deg"], dem["dilatancy_angle_deg"]),
         "| sand's oedometric modulus E_oed [MPa], porosity n, hydraulic conductivity k [m s⁻¹] | %s | %s |"
         % tuple(_sand(s) for s in (mpm, dem)),
@@ -234,12 +243,12 @@ def report(out_dir, result):
         " lid and at the walls is more open than the bulk." % (
             1e3 * dem["grain_diameter_m"], dem["slice_width_m"] / dem["grain_diameter_m"],
             "PFV's conductance comes from the pile's own pores, the MPM sand's k from the flow test on a box of the same grains"
-            " (a smooth box's wall layer and a rained pile's packing differ)" if mpm.get("strength_from_dem") else
+            " (a smooth box's wall layer and a rained pile's packing differ)" if mpm.get("strength_from_dem") and not mpm.get("only_strength_from_dem") else
             "PFV's conductance comes from the grains' pores (coarse grains: a far larger discharge than the MPM sand's k, which"
             " changes the time scale of drainage, not the seepage force at a given gradient)", dem["ramp_time_s"],
-            "the MPM sand has the DEM grains' triaxial strength (φ, φ_r, ψ) and oedometric stiffness, but is a Mohr–Coulomb"
-            " continuum with linear elasticity and exponential"
-            " softening, where the grains rotate against a rolling resistance" if mpm.get("strength_from_dem") else
+            "the MPM sand has the DEM grains' triaxial strength (φ, φ_r, ψ)%s, but is a Mohr–Coulomb continuum with linear"
+            " elasticity and exponential softening, where the grains rotate against a rolling resistance"
+            % ("" if mpm.get("only_strength_from_dem") else " and oedometric stiffness") if mpm.get("strength_from_dem") else
             "the DEM sand dilates more (ψ from the triaxial) and its grains rotate against a rolling resistance calibrated to the MPM's φ"),
         "",
         "![probe pressures and slope-face displacement against the head](sandpile.png)",
