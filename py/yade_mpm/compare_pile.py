@@ -93,7 +93,8 @@ def _side(model, summary, columns, width, still, unit_weight, water_density):
                  "oedometric_modulus_Pa": analytical.constrained_modulus(summary["scene"]["young_modulus"], summary["scene"]["poisson_ratio"]),
                  "porosity": summary["scene"]["porosity"], "hydraulic_conductivity_m_per_s": summary["scene"]["hydraulic_conductivity"]}
     conductance = discharge / (head[late] - still)
-    return dict(extra, model=model, onset_head_m=onset, sliding_surface=summary.get("sliding_surface"),
+    onset_time = summary.get("onset_time_s") if model == "DEM" else (summary.get("onset") or {}).get("time_s")
+    return dict(extra, model=model, onset_head_m=onset, onset_time_s=onset_time, sliding_surface=summary.get("sliding_surface"),
                 first_mobilised_zone=summary.get("first_mobilised_zone"), lem_onset_head_m=lem, bodies=bodies, wall_s=wall, simulated_s=simulated,
                 head_rise_m=float(np.nanmax(head) - still), wall_s_per_simulated_s=wall / simulated,
                 wall_s_per_cm_of_rise=wall / (100 * float(np.nanmax(head) - still)),
@@ -204,6 +205,8 @@ def report(out_dir, result):
         "| | MPM | DEM + PFV |",
         "|---|---|---|",
         "| onset head (slope face's compliance) [m] | %s | %s |" % (_m(mpm["onset_head_m"]), _m(dem["onset_head_m"])),
+        "| onset time [s] (from the start of settling; the DEM's rise is compressed) | %s | %s |"
+        % tuple("—" if s.get("onset_time_s") is None else "%.2f" % s["onset_time_s"] for s in (mpm, dem)),
         "| Bishop on the run's own pressure field, F = 1 at head [m] | %s (slides ≥ 1 cell), %s (≥ 3 cells) | %s (≥ 2 diameters) |"
         % (_m(mpm["lem_one_cell_onset_head_m"]), _m(mpm["lem_onset_head_m"]), _m(dem["lem_onset_head_m"])),
         "| MPM inertia scaling released at head [m] | %s (α = %s) | — |" % (_m(mpm.get("inertia_release_head_m")), mpm.get("inertia_scale")),

@@ -49,7 +49,9 @@ def runs(tmp_path):
     mpm["injected_kg"] = np.cumsum([0.0] + [0.2 * (0.5 * (a + b) - STILL) * dt for a, b, dt in zip(heads, heads[1:], np.diff(t))]).tolist()
     _write(tmp_path / "mpm", {"scene": scene, "gravity_m_per_s2": [0, 0, -G], "onset_head_m": 0.205, "lem_onset_head_m": 0.17,
                               "lem_deep_onset_head_m": 0.215, "inertia_scale": 100, "inertia_scale_release_time_s": 31.0,
-                              "points_per_phase_initial": 2400, "cell_size_m": 0.02, "run_time_s": 410.0, "simulated_time_s": 41.0},
+                              "points_per_phase_initial": 2400, "cell_size_m": 0.02, "run_time_s": 410.0, "simulated_time_s": 41.0,
+                              "onset": {"time_s": 28.5, "head_m": 0.205},
+                              "first_mobilised_zone": {"x_range_m": [0.015, 0.175], "z_range_m": [0.075, 0.115]}},
            mpm)
     # DEM: the same heads over 0.4 s; 0.02 m³/s per metre of excess head through the 0.03 m slice
     t = np.linspace(0, 0.52, 53)
@@ -59,6 +61,7 @@ def runs(tmp_path):
     dem["inflow_m3_per_s"] = [0.02 * max(h - STILL, 0.0) for h in heads]
     _write(tmp_path / "dem", {"onset_head_m": 0.213, "lem_onset_head_m": 0.21, "grains": 180, "base_grains": 35, "grain_radius_m": 0.0075,
                               "slice_width_m": 0.03, "ramp_time_s": 0.4, "simulated_time_s": 0.52, "run_wall_s": 18.0, "build_wall_s": 8.0,
+                              "onset_time_s": 0.32, "first_mobilised_zone": {"x_range_m": [0.004, 0.161], "z_range_m": [0.077, 0.116]},
                               "triaxial": {"peak_friction_angle_deg": 36.0, "dilatancy_angle_deg": 15.6}}, dem)
     return tmp_path
 
@@ -85,7 +88,7 @@ def test_the_comparison_reports_its_inputs(runs):
 
 
 def test_the_command_writes_the_report_and_refuses_a_scene_pfv_cannot_model(runs):
-    """The command writes report.md (with both onset heads), report.json and the figure; an MPM
+    """The command writes report.md (with both onset heads and times and the first mobilised zones), report.json and the figure; an MPM
     run of the pile in air (no still water, no lid) is refused with the command that makes a usable one."""
     out = runs / "report"
     done = subprocess.run(["/usr/bin/python3", "-m", "yade_mpm.compare", "sandpile", "--mpm-run", str(runs / "mpm"), "--dem-run",
@@ -93,6 +96,8 @@ def test_the_command_writes_the_report_and_refuses_a_scene_pfv_cannot_model(runs
     assert done.returncode == 0, done.stderr[-2000:]
     text = (out / "report.md").read_text()
     assert "| onset head (slope face's compliance) [m] | 0.205 | 0.213 |" in text
+    assert "| onset time [s] (from the start of settling; the DEM's rise is compressed) | 28.50 | 0.32 |" in text
+    assert "| first mobilised zone at the onset (x range; z range) [m] | 0.015–0.175; 0.075–0.115 | 0.004–0.161; 0.077–0.116 |" in text
     assert "| Bishop on the run's own pressure field, F = 1 at head [m] | 0.170 (slides ≥ 1 cell), 0.215 (≥ 3 cells) | 0.210" in text
     assert json.load(open(out / "report.json"))["dem"]["onset_head_m"] == 0.213
     assert (out / "sandpile.png").stat().st_size > 10000
