@@ -53,6 +53,9 @@ class OedometerSample:
         return O.forces.f(self.wall_ids[XMAX])[0] / self.area
 
 
+BOX_RADIUS_SPREAD = 0.3333  # default relative spread of the test boxes' radii about their mean [-] (the pile's grains: dem_pile.RADIUS_SPREAD)
+
+
 def _require(name, value, valid, text):
     if not valid:
         raise ValueError("%s = %r is outside the valid range %s" % (name, value, text))
@@ -83,7 +86,7 @@ def contact_loop(rolling_resistance):
 
 
 def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle, grain_density, seed, rolling_resistance=None,
-                   radius_spread=0.3333):
+                   radius_spread=BOX_RADIUS_SPREAD):
     """Reset the scene; spheres (radii uniform within ± `radius_spread` of their mean, relative) in a
     width³ box of smooth walls compacted isotropically to `stress`
     by particle growth with 3° contact friction and no rolling resistance (a dense packing), then
@@ -134,7 +137,7 @@ def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle
 
 
 def oedometer_sample(grains=300, width=1.0, stress=10e3, young=1e6, contact_poisson=0.5, friction_angle=math.radians(30),
-                     grain_density=2600.0, seed=1, rolling_resistance=None, radius_spread=0.3333):
+                     grain_density=2600.0, seed=1, rolling_resistance=None, radius_spread=BOX_RADIUS_SPREAD):
     """Reset the scene and build a sphere assembly in a width³ box, compacted isotropically to
     `stress` [Pa] by particle growth with low friction (3°, for a dense packing), then given its
     contact `friction_angle` [rad] and brought to oedometric equilibrium under the vertical
@@ -297,7 +300,7 @@ def consolidate(sample, load, viscosity, times, depths=(0.3, 0.5, 0.7, 0.9), tim
 
 
 def drained_triaxial(grains=300, confinement=10e3, friction_angle=math.radians(30), strain_rate=0.02, final_strain=0.15, width=1.0,
-                     young=1e6, contact_poisson=0.5, grain_density=2600.0, seed=1, rolling_resistance=None, radius_spread=0.3333):
+                     young=1e6, contact_poisson=0.5, grain_density=2600.0, seed=1, rolling_resistance=None, radius_spread=BOX_RADIUS_SPREAD):
     """A drained triaxial compression on the same kind of assembly: compacted isotropically to
     `confinement` [Pa], then the top wall moves at the axial `strain_rate` [s⁻¹] (slow enough for
     quasi-static shearing: an inertial number ε̇ d √(ρs/σ3) ≈ 1e-3 here) while the side walls hold σ3,
