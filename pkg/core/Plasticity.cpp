@@ -19,6 +19,8 @@ void StrengthParameters::validate() const
 	if (!(residualFrictionAngle > 0 && residualFrictionAngle <= frictionAngle))
 		throwOutOfRange("residualFrictionAngle", residualFrictionAngle, "rad", "(0, frictionAngle]");
 	requireClosedRange("softeningStrain", softeningStrain, 0, inf, "");
+	requireClosedRange("nonlocalLength", nonlocalLength, 0, inf, "m");
+	requireClosedRange("nonlocalWeight", nonlocalWeight, 1, inf, "");
 }
 
 Real StrengthParameters::frictionAngleAt(Real kappa) const

@@ -21,9 +21,15 @@ struct StrengthParameters {
 	Real tensionCutoff         = 0.0;    // σ_t [Pa], ≥ 0: the largest isotropic tension carried
 	Real residualFrictionAngle = 0.5236; // φ_r [rad], 0 < φ_r ≤ φ: reached by softening
 	Real softeningStrain       = 0.0;    // κ_s [-], ≥ 0: φ(κ) = φ_r + (φ − φ_r) exp(−κ/κ_s); 0: none
+	// Internal length l [m], ≥ 0, of the over-nonlocal softening (theory.md eq. 7.1c): φ is taken at
+	// κ* = (1 − m) κ + m κ̄, κ̄ the Gaussian average of κ over a radius of about l; 0: local softening
+	// (a shear band one cell wide, its post-peak response mesh-dependent). Needs l ≥ h/2.
+	Real nonlocalLength = 0.0;
+	Real nonlocalWeight = 2.0; // m [-], ≥ 1: weight of the average in κ* (1: plain nonlocal; 2: Vermeer & Brinkgreve's over-nonlocal)
 
 	void validate() const;
 	Real frictionAngleAt(Real plasticShearStrain) const; // φ(κ) [rad]
+	bool nonlocal() const { return softeningStrain > 0 && nonlocalLength > 0; } // eq. 7.1c applies
 	// ψ [rad] at the current friction angle φ(κ): the dilatancy fades with the friction's excess
 	// over the residual (critical-state) value, ψ (φ(κ) − φ_r)/(φ − φ_r) (theory.md eq. 7.1b), so it
 	// is ψ without softening; never above φ(κ)

@@ -12,7 +12,8 @@ namespace mpm {
 namespace stages {
 	using namespace detail;
 
-	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, SolidSet& set, Real dt)
+	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, const std::vector<Real>* softeningStrain,
+	                       SolidSet& set, Real dt)
 	{
 		SolidPointSet&    P      = *set.points;
 		const Real        E      = set.soil.youngModulus, nu = set.soil.poissonRatio;
@@ -34,9 +35,10 @@ namespace stages {
 			const Mat3 sigma = voigtToMatrix(P.effectiveStress[p]);
 			const Mat3 rate  = lambda * d.trace() * Mat3::Identity() + 2 * shear * d; // D^e : d
 			const Mat3 trial = sigma + dt * (spin * sigma - sigma * spin + rate);     // eq. 4.15 (Jaumann)
-			if (plastic) { // eqs. 7.3–7.5
-				const ReturnResult r = mohrCoulomb ? returnMohrCoulomb(trial, bulk, shear, set.strength, P.plasticShearStrain[p])
-				                                   : returnDruckerPrager(trial, bulk, shear, set.strength, P.plasticShearStrain[p]);
+			if (plastic) { // eqs. 7.3–7.5, the friction at the point's κ or the regularised κ* (eq. 7.1c)
+				const Real         kappa = softeningStrain ? (*softeningStrain)[p] : P.plasticShearStrain[p];
+				const ReturnResult r     = mohrCoulomb ? returnMohrCoulomb(trial, bulk, shear, set.strength, kappa)
+				                                       : returnDruckerPrager(trial, bulk, shear, set.strength, kappa);
 				P.effectiveStress[p] = matrixToVoigt(r.stress);
 				P.plasticShearStrain[p] += r.plasticShearStrain;
 			} else {

@@ -52,6 +52,11 @@ struct ScatterWorkspace {
 	std::vector<Vec3>                      contactVelocity; // the contact nodes' velocity kept through the re-map
 };
 
+// Scratch of the over-nonlocal softening (theory.md eq. 7.1c): per grid cell (indexed by its lower node).
+struct NonlocalScratch {
+	std::vector<Real> strain, volume; // Σ V κ and Σ V per cell, then their Gaussian convolutions
+};
+
 // Scratch of the pressure-mode damping (eqs. 4.17b–c): per grid node or cell (cells are indexed by
 // their lower node) and per water point.
 struct PressureModeScratch {
@@ -218,8 +223,19 @@ namespace stages {
 
 	// Step 9 (theory.md eqs. 4.14–4.15, §7): deformation gradient, volume, Jaumann elastic trial
 	// stress, return mapping of the set's skeleton model, porosity; `volumetricRate` (one per
-	// point) replaces tr d when given (cell-averaged volumetric strain rate, B-bar).
-	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, SolidSet& set, Real dt);
+	// point) replaces tr d when given (cell-averaged volumetric strain rate, B-bar); `softeningStrain`
+	// (one per point) is the κ the friction is taken at (eq. 7.1c) when given, else the point's own κ.
+	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, const std::vector<Real>* softeningStrain,
+	                       SolidSet& set, Real dt);
+
+	// The Gaussian average w(r) = exp(−|r|²/l²) is truncated at |r_d| ≤ nonlocalTruncation l per axis.
+	constexpr Real nonlocalTruncation = 2;
+	// Step 9, before the return (theory.md eq. 7.1c): κ* = max(0, (1 − m) κ + m κ̄) at every point of a
+	// set, κ̄ = ∫ w κ dV / ∫ w dV over the set's material with l = strength.nonlocalLength,
+	// m = strength.nonlocalWeight; the integrals by the points binned to grid cells (at the cell
+	// centres), three 1D convolutions, κ̄ trilinear from the cell centres to the point.
+	void nonlocalPlasticStrain(const GridGeometry& grid, const SolidPointSet& points, const StrengthParameters& strength, std::vector<Real>& regularised,
+	                           NonlocalScratch& scratch);
 
 	// Step 10 (theory.md eq. 4.16): ∇·v^w at every water point and, when `pressureRate` is given
 	// (explicit scheme), the pore-pressure rate ṗ = −(Kw/n)[(1−n)∇·v^s + n∇·v^w], from the

@@ -168,6 +168,12 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 	for (std::size_t s = 0; s < solids.size(); ++s) {
 		solids[s].soil.validate();
 		if (solids[s].model != SkeletonModel::LinearElastic) solids[s].strength.validate();
+		// the average must resolve its Gaussian (eq. 7.1c): a length under half a cell would average over one cell only
+		if (solids[s].model != SkeletonModel::LinearElastic && solids[s].strength.nonlocal() && solids[s].strength.nonlocalLength < 0.5 * grid_.cellSize) {
+			std::ostringstream range;
+			range << "{0} ∪ [cellSize/2 = " << 0.5 * grid_.cellSize << " m, inf) (the average must resolve its Gaussian, theory.md eq. 7.1c)";
+			throwOutOfRange("nonlocalLength", solids[s].strength.nonlocalLength, "m", range.str());
+		}
 		if (solids[s].name.empty()) solids[s].name = "solid set " + std::to_string(s);
 		solids[s].points->validate(solids[s].name, fieldNames_);
 		requireDomainsInACell(*solids[s].points, solids[s].name);
@@ -601,7 +607,12 @@ void TwoPhaseSolver::updateSkeleton(Real dt)
 {
 	StageTimer t(stageSeconds_, Stage::UpdateSolidStress);
 	const bool average = settings_.cellAveragedVolumetricRate;
-	for (std::size_t s = 0; s < solids_.size(); ++s) stages::updateSolidStress(skeletonGradients_[s], average ? &skeletonVolumetric_[s] : nullptr, solids_[s], dt);
+	for (std::size_t s = 0; s < solids_.size(); ++s) {
+		const SolidSet& set      = solids_[s];
+		const bool      nonlocal = set.model != SkeletonModel::LinearElastic && set.strength.nonlocal();
+		if (nonlocal) stages::nonlocalPlasticStrain(grid_, *set.points, set.strength, softeningStrain_, nonlocalScratch_); // eq. 7.1c
+		stages::updateSolidStress(skeletonGradients_[s], average ? &skeletonVolumetric_[s] : nullptr, nonlocal ? &softeningStrain_ : nullptr, solids_[s], dt);
+	}
 }
 
 template <class Kernel> void TwoPhaseSolver::updateWater(Real dt, bool semiImplicit)

@@ -194,7 +194,7 @@ TEST(PatchTest, UniformStressGivesZeroInteriorForceAndUniformStrainUniformStress
 			for (int i = 0; i < box.grid.nodes[0]; ++i) field[box.grid.index(i, j, k)] = A * box.grid.nodePosition(i, j, k);
 	std::vector<Mat3> L;
 	stages::computeVelocityGradients<GimpKernel>(box.grid, field, s, L);
-	stages::updateSolidStress(L, nullptr, solids[0], 1e-2);
+	stages::updateSolidStress(L, nullptr, nullptr, solids[0], 1e-2);
 	for (std::size_t p = 1; p < s.size(); ++p) EXPECT_LT((s.effectiveStress[p] - s.effectiveStress[0]).norm(), 1e-9 * sigma.norm());
 	// and it is σ + Δt (Wσ − σW + λ tr d I + 2G d)
 	const Mat3 d = 0.5 * (A + A.transpose()), W = 0.5 * (A - A.transpose()), S = voigtToMatrix(sigma);
