@@ -85,10 +85,10 @@ const AttrTable<MpmSoilMat>& MpmSoilMat::attributes()
 		valueAttr<M>("softeningStrain", [](M& m) -> auto& { return m.strength_.softeningStrain; },
 		             "Softening scale κ_s of φ(κ) = φ_r + (φ − φ_r) exp(−κ/κ_s) with the accumulated plastic shear strain κ [-], ≥ 0; 0: no softening"),
 		valueAttr<M>("nonlocalLength", [](M& m) -> auto& { return m.strength_.nonlocalLength; },
-		             "Internal length l of the over-nonlocal softening [m], 0 or ≥ cellSize/2; default 0 (local): φ is taken at κ* = (1 − m) κ + m κ̄, κ̄ the "
+		             "Internal length l of the over-nonlocal softening [m], 0 (local) or ≥ the engine's cellSize/2: φ is taken at κ* = (1 − m) κ + m κ̄, κ̄ the "
 		             "Gaussian average exp(−r²/l²) of κ around the point, so a shear band's width and post-peak response follow l, not the cell size (theory.md eq. 7.1c)"),
 		valueAttr<M>("nonlocalWeight", [](M& m) -> auto& { return m.strength_.nonlocalWeight; },
-		             "Weight m of the average in κ* = (1 − m) κ + m κ̄ [-], ≥ 1; default 2 (Vermeer & Brinkgreve's over-nonlocal; 1: plain nonlocal)"),
+		             "Weight m of the average in κ* = (1 − m) κ + m κ̄ [-], ≥ 1 (2: Vermeer & Brinkgreve's over-nonlocal; 1: plain nonlocal)"),
 	};
 	return table;
 }

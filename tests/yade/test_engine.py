@@ -62,6 +62,19 @@ def test_bad_point_data_stops_before_any_work_with_a_clear_message():
     assert O.engines[0].stepsDone == 0 and O.engines[0].mpmTime == 0
 
 
+def test_an_unresolved_nonlocal_length_stops_before_any_work_naming_the_cell_size():
+    """theory.md eq. 7.1c: the Gaussian average of the softening strain must be resolved by the grid,
+    l ≥ h/2; a shorter one would average over one cell and regularise nothing."""
+    soil = w.MpmSoilMat(model="MohrCoulomb", softeningStrain=0.1, nonlocalLength=0.02)
+    water = w.MpmWaterMat()
+    O.materials.append([soil, water])
+    O.bodies.append(list(yade_mpm.saturated_block((0, 0, 0), (0.1, 0.1, 0.1), 0.05, soil, water, points_per_cell=2)))
+    O.engines = [w.MpmTwoPhaseEngine(label="mpm", domainMin=(0, 0, 0), domainMax=(0.1, 0.1, 0.1), cellSize=0.05)]
+    with pytest.raises(ValueError, match=r"nonlocalLength = 0.02 m is outside the valid range \{0\} ∪ \[cellSize/2 = 0.025 m, inf\)"):
+        O.step()
+    assert O.engines[0].stepsDone == 0 and O.engines[0].mpmTime == 0
+
+
 @pytest.mark.parametrize("friction", [-0.1, float("nan"), float("inf")])
 def test_bad_wall_friction_stops_before_any_work_with_a_clear_message(friction):
     soil, water = w.MpmSoilMat(), w.MpmWaterMat()
