@@ -20,25 +20,10 @@ namespace stages {
 	{
 		const std::size_t count = P.size(), cells = grid.nodeCount();
 		const Real        h = grid.cellSize, l = strength.nonlocalLength, m = strength.nonlocalWeight;
-		// κ V and V per cell (cells indexed by their lower node): the points as the quadrature of the
-		// averaging integrals, each at its cell's centre
+		// κ V and V per cell: the points as the quadrature of the averaging integrals, each at its cell's centre
 		std::vector<Real>& strain = scratch.strain;
 		std::vector<Real>& volume = scratch.volume;
-		strain.assign(cells, 0);
-		volume.assign(cells, 0);
-		auto cellIndex = [&](std::size_t p) {
-			const std::array<int, 3> c = cellOf(grid, P.position[p]);
-			return grid.index(c[0], c[1], c[2]);
-		};
-#pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t p = 0; p < count; ++p) {
-			const std::size_t c = cellIndex(p);
-			const Real        v = P.volume[p];
-#pragma omp atomic
-			strain[c] += v * P.plasticShearStrain[p];
-#pragma omp atomic
-			volume[c] += v;
-		}
+		sumOverCells(grid, P, P.plasticShearStrain, strain, volume);
 		// w(r) = exp(−|r|²/l²) is a product of 1D Gaussians: three passes of a 1D convolution over the
 		// cell centres, each truncated at |r_d| ≤ truncation·l (the weight there is e⁻⁴ ≈ 2% of the centre's)
 		const int         reach = static_cast<int>(std::floor(nonlocalTruncation * l / h));

@@ -202,6 +202,11 @@ namespace stages {
 	void computeVelocityGradients(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const MaterialPointSet& points,
 	                              std::vector<Mat3>& gradients);
 
+	// Σ V value and Σ V over the points of each grid cell (cells indexed by their lower node;
+	// `cellSum`/`cellVolume` get grid.nodeCount() entries).
+	void sumOverCells(const GridGeometry& grid, const MaterialPointSet& points, const std::vector<Real>& values, std::vector<Real>& cellSum,
+	                  std::vector<Real>& cellVolume);
+
 	// Replace each point's value by the volume-weighted mean over the points of its grid cell
 	// (theory.md eq. 4.17): removes the intra-cell pressure mode of nearly incompressible water.
 	// `cellSum`/`cellVolume` are scratch arrays of grid.nodeCount() entries.

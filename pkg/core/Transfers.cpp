@@ -208,29 +208,34 @@ namespace stages {
 		}
 	}
 
-	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& P, std::vector<Real>& values, std::vector<Real>& cellSum,
-	                      std::vector<Real>& cellVolume)
+	void sumOverCells(const GridGeometry& grid, const MaterialPointSet& P, const std::vector<Real>& values, std::vector<Real>& cellSum,
+	                  std::vector<Real>& cellVolume)
 	{
 		const std::size_t count = P.size(), cells = grid.nodeCount();
 		cellSum.assign(cells, 0);
 		cellVolume.assign(cells, 0);
-		auto cellIndex = [&](std::size_t p) {
-			const std::array<int, 3> c = cellOf(grid, P.position[p]);
-			return grid.index(c[0], c[1], c[2]);
-		};
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
-			const std::size_t c = cellIndex(p);
-			const Real        v = P.volume[p];
+			const std::array<int, 3> cell = cellOf(grid, P.position[p]);
+			const std::size_t        c    = grid.index(cell[0], cell[1], cell[2]);
+			const Real               v    = P.volume[p];
 #pragma omp atomic
 			cellSum[c] += v * values[p];
 #pragma omp atomic
 			cellVolume[c] += v;
 		}
+	}
+
+	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& P, std::vector<Real>& values, std::vector<Real>& cellSum,
+	                      std::vector<Real>& cellVolume)
+	{
+		sumOverCells(grid, P, values, cellSum, cellVolume);
+		const std::size_t count = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
-			const std::size_t c = cellIndex(p);
-			values[p]           = cellSum[c] / cellVolume[c];
+			const std::array<int, 3> cell = cellOf(grid, P.position[p]);
+			const std::size_t        c    = grid.index(cell[0], cell[1], cell[2]);
+			values[p]                     = cellSum[c] / cellVolume[c];
 		}
 	}
 

@@ -91,8 +91,11 @@ TEST(NonlocalStrain, AOneCellBandSpreadsAsTheDiscreteGaussian)
 	// and positive a cell beside it
 	for (std::size_t p = 0; p < b.points.size(); ++p) {
 		const int cell = static_cast<int>(std::floor(b.points.position[p].x() / h));
-		if (cell == band) EXPECT_EQ(regularised[p], 0);
-		if (cell == band + 1) EXPECT_GT(regularised[p], 0.3);
+		if (cell == band) {
+			EXPECT_EQ(regularised[p], 0);
+		} else if (cell == band + 1) {
+			EXPECT_GT(regularised[p], 0.3);
+		}
 	}
 }
 
