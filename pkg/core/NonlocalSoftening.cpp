@@ -23,7 +23,8 @@ namespace stages {
 		// κ V and V per cell: the points as the quadrature of the averaging integrals, each at its cell's centre
 		std::vector<Real>& strain = scratch.strain;
 		std::vector<Real>& volume = scratch.volume;
-		sumOverCells(grid, P, P.plasticShearStrain, strain, volume);
+		binPointsByCell(grid, P, scratch.bins);
+		sumOverCells(scratch.bins, P, P.plasticShearStrain, strain, volume);
 		// w(r) = exp(−|r|²/l²) is a product of 1D Gaussians: three passes of a 1D convolution over the
 		// cell centres, each truncated at |r_d| ≤ truncation·l (the weight there is e⁻⁴ ≈ 2% of the centre's)
 		const int         reach = static_cast<int>(std::floor(nonlocalTruncation * l / h));

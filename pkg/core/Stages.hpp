@@ -53,8 +53,17 @@ struct ScatterWorkspace {
 };
 
 // Scratch of the over-nonlocal softening (theory.md eq. 7.1c): per grid cell (indexed by its lower node).
+// Points of one set grouped by the grid cell that holds them (stages::binPointsByCell): the cell
+// averages (eq. 4.17) and the nonlocal integrals (eq. 7.1c) then sum cell by cell without atomics.
+struct CellBins {
+	std::vector<std::size_t> cell;  // the cell of each point (its lower node's index)
+	std::vector<std::size_t> first; // offset of each cell's points in `point`: grid.nodeCount() + 1 entries
+	std::vector<std::size_t> point; // point indices grouped by cell, ascending within a cell
+};
+
 struct NonlocalScratch {
 	std::vector<Real> strain, volume; // Σ V κ and Σ V per cell, then their Gaussian convolutions
+	CellBins          bins;           // the points by cell
 };
 
 // Scratch of the pressure-mode damping (eqs. 4.17b–c): per grid node or cell (cells are indexed by
@@ -202,15 +211,20 @@ namespace stages {
 	void computeVelocityGradients(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const MaterialPointSet& points,
 	                              std::vector<Mat3>& gradients);
 
-	// Σ V value and Σ V over the points of each grid cell (cells indexed by their lower node;
-	// `cellSum`/`cellVolume` get grid.nodeCount() entries).
-	void sumOverCells(const GridGeometry& grid, const MaterialPointSet& points, const std::vector<Real>& values, std::vector<Real>& cellSum,
+	// Bin the points of one set by the grid cell that holds them (a counting sort; cells indexed by
+	// their lower node). Valid until the points move or the set changes size.
+	void binPointsByCell(const GridGeometry& grid, const MaterialPointSet& points, CellBins& bins);
+
+	// Σ V value and Σ V over the points of each grid cell of `bins` (binPointsByCell of the same
+	// points; `cellSum`/`cellVolume` get grid.nodeCount() entries). Each cell adds its points in
+	// ascending index order: no atomics, and the same numbers for any thread count.
+	void sumOverCells(const CellBins& bins, const MaterialPointSet& points, const std::vector<Real>& values, std::vector<Real>& cellSum,
 	                  std::vector<Real>& cellVolume);
 
 	// Replace each point's value by the volume-weighted mean over the points of its grid cell
 	// (theory.md eq. 4.17): removes the intra-cell pressure mode of nearly incompressible water.
-	// `cellSum`/`cellVolume` are scratch arrays of grid.nodeCount() entries.
-	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& points, std::vector<Real>& values, std::vector<Real>& cellSum,
+	// `bins` from binPointsByCell of the same points; `cellSum`/`cellVolume` are scratch arrays.
+	void averageOverCells(const CellBins& bins, const MaterialPointSet& points, std::vector<Real>& values, std::vector<Real>& cellSum,
 	                      std::vector<Real>& cellVolume);
 
 	// Pressure-mode damping (theory.md eqs. 4.17b–c): p ← p + r (p̃ − p). On points whose stencil

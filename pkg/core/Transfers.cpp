@@ -208,35 +208,49 @@ namespace stages {
 		}
 	}
 
-	void sumOverCells(const GridGeometry& grid, const MaterialPointSet& P, const std::vector<Real>& values, std::vector<Real>& cellSum,
-	                  std::vector<Real>& cellVolume)
+	void binPointsByCell(const GridGeometry& grid, const MaterialPointSet& P, CellBins& bins)
 	{
 		const std::size_t count = P.size(), cells = grid.nodeCount();
-		cellSum.assign(cells, 0);
-		cellVolume.assign(cells, 0);
+		bins.cell.resize(count);
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
-			const std::array<int, 3> cell = cellOf(grid, P.position[p]);
-			const std::size_t        c    = grid.index(cell[0], cell[1], cell[2]);
-			const Real               v    = P.volume[p];
-#pragma omp atomic
-			cellSum[c] += v * values[p];
-#pragma omp atomic
-			cellVolume[c] += v;
+			const std::array<int, 3> c = cellOf(grid, P.position[p]);
+			bins.cell[p]               = grid.index(c[0], c[1], c[2]);
+		}
+		// counting sort: one serial pass to count, one to place (O(N), in point order)
+		bins.first.assign(cells + 1, 0);
+		for (std::size_t p = 0; p < count; ++p) ++bins.first[bins.cell[p] + 1];
+		for (std::size_t c = 0; c < cells; ++c) bins.first[c + 1] += bins.first[c];
+		bins.point.resize(count);
+		std::vector<std::size_t> next(bins.first.begin(), bins.first.end() - 1);
+		for (std::size_t p = 0; p < count; ++p) bins.point[next[bins.cell[p]]++] = p;
+	}
+
+	void sumOverCells(const CellBins& bins, const MaterialPointSet& P, const std::vector<Real>& values, std::vector<Real>& cellSum,
+	                  std::vector<Real>& cellVolume)
+	{
+		const std::size_t cells = bins.first.size() - 1;
+		cellSum.resize(cells);
+		cellVolume.resize(cells);
+#pragma omp parallel for schedule(static) if(P.size() > parallelThreshold)
+		for (std::size_t c = 0; c < cells; ++c) {
+			Real sum = 0, volume = 0;
+			for (std::size_t k = bins.first[c]; k < bins.first[c + 1]; ++k) {
+				const std::size_t p = bins.point[k];
+				sum += P.volume[p] * values[p];
+				volume += P.volume[p];
+			}
+			cellSum[c] = sum, cellVolume[c] = volume;
 		}
 	}
 
-	void averageOverCells(const GridGeometry& grid, const MaterialPointSet& P, std::vector<Real>& values, std::vector<Real>& cellSum,
+	void averageOverCells(const CellBins& bins, const MaterialPointSet& P, std::vector<Real>& values, std::vector<Real>& cellSum,
 	                      std::vector<Real>& cellVolume)
 	{
-		sumOverCells(grid, P, values, cellSum, cellVolume);
+		sumOverCells(bins, P, values, cellSum, cellVolume);
 		const std::size_t count = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t p = 0; p < count; ++p) {
-			const std::array<int, 3> cell = cellOf(grid, P.position[p]);
-			const std::size_t        c    = grid.index(cell[0], cell[1], cell[2]);
-			values[p]                     = cellSum[c] / cellVolume[c];
-		}
+		for (std::size_t p = 0; p < count; ++p) values[p] = cellSum[bins.cell[p]] / cellVolume[bins.cell[p]];
 	}
 
 #define MPM_INSTANTIATE(K) \

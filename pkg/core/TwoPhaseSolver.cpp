@@ -589,7 +589,8 @@ template <class Kernel> void TwoPhaseSolver::skeletonRates()
 		std::vector<Real>& rate = skeletonVolumetric_[s];
 		rate.resize(skeletonGradients_[s].size());
 		for (std::size_t p = 0; p < rate.size(); ++p) rate[p] = skeletonGradients_[s][p].trace();
-		stages::averageOverCells(grid_, *solids_[s].points, rate, cellSum_, cellVolume_);
+		stages::binPointsByCell(grid_, *solids_[s].points, cellBins_);
+		stages::averageOverCells(cellBins_, *solids_[s].points, rate, cellSum_, cellVolume_);
 	}
 }
 
@@ -625,8 +626,9 @@ template <class Kernel> void TwoPhaseSolver::updateWater(Real dt, bool semiImpli
 		computePressureRates<Kernel>(grid_, fields_.solidVelocityNew, fields_.waterVelocityNew, *w, water_, semiImplicit ? nullptr : &pressureRate_,
 		                             waterDivergence_);
 		if (average) {
-			if (!semiImplicit) averageOverCells(grid_, *w, pressureRate_, cellSum_, cellVolume_);
-			averageOverCells(grid_, *w, waterDivergence_, cellSum_, cellVolume_);
+			binPointsByCell(grid_, *w, cellBins_);
+			if (!semiImplicit) averageOverCells(cellBins_, *w, pressureRate_, cellSum_, cellVolume_);
+			averageOverCells(cellBins_, *w, waterDivergence_, cellSum_, cellVolume_);
 		}
 		if (!semiImplicit) updatePorePressure(pressureRate_, *w, dt);
 		updateWaterVolume(waterDivergence_, *w, dt);

@@ -178,6 +178,7 @@ private:
 	std::vector<std::vector<Mat3>> skeletonGradients_;  // per solid set: velocity gradients L_p of this step (eqs. 4.13, 8.9)
 	std::vector<std::vector<Real>> skeletonVolumetric_; // per solid set: their cell-averaged traces (eq. 4.17)
 	std::vector<Real>             pressureRate_, waterDivergence_, cellSum_, cellVolume_;
+	CellBins                      cellBins_; // the points of the set being cell-averaged, by cell (eq. 4.17)
 	std::vector<Real>             softeningStrain_; // κ* of the set being updated (eq. 7.1c)
 	NonlocalScratch               nonlocalScratch_;
 	std::vector<SolidSet>         solids_;

@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
+#include <cmath>
 #include <random>
 
 namespace {
@@ -221,6 +224,51 @@ TEST(CpGimp, DomainsFollowTheStretchWithinBounds)
 	EXPECT_LT((s.halfLength[0] - Vec3(0.03, 0.0225, 0.025)).norm(), 1e-15);
 	EXPECT_LT((s.halfLength[1] - Vec3(h / 2, 0.01 * h, 0.025)).norm(), 1e-15);
 	EXPECT_LT((s.halfLength[2] - Vec3(0.0275, 0.025, 0.02)).norm(), 1e-15);
+}
+
+// The cell average of eq. 4.17 (and the nonlocal integrals of eq. 7.1c) sum the points of each
+// cell. With the points binned by cell (a counting sort) each cell adds its points in ascending
+// index order: the sums must be those of a serial loop over the points bit for bit, whatever the
+// thread count (the atomic adds used before summed in the order the threads happened to reach a
+// cell, so two runs with two threads could differ), and the average must keep each cell's Σ V value.
+TEST(CellAverage, SumsEachCellInPointOrderForAnyThreadCount)
+{
+	std::mt19937_64                      rng(11);
+	Box                                  box;
+	SolidPointSet                        s = randomSolid(6000, rng); // above the parallel threshold
+	std::uniform_real_distribution<Real> value(-3, 5), volume(0.5e-4, 2e-4);
+	std::vector<Real>                    values(s.size());
+	for (std::size_t p = 0; p < s.size(); ++p) values[p] = value(rng), s.volume[p] = volume(rng);
+	const std::size_t cells = box.grid.nodeCount();
+	std::vector<Real> referenceSum(cells, 0), referenceVolume(cells, 0);
+	std::vector<std::size_t> cellOfPoint(s.size());
+	for (std::size_t p = 0; p < s.size(); ++p) {
+		const Vec3 u = (s.position[p] - box.grid.origin) / box.grid.cellSize;
+		cellOfPoint[p] = box.grid.index(static_cast<int>(std::floor(u[0])), static_cast<int>(std::floor(u[1])), static_cast<int>(std::floor(u[2])));
+		referenceSum[cellOfPoint[p]] += s.volume[p] * values[p];
+		referenceVolume[cellOfPoint[p]] += s.volume[p];
+	}
+	const int threadsBefore = omp_get_max_threads();
+	for (int threads : { 1, 2 }) {
+		omp_set_num_threads(threads);
+		CellBins          bins;
+		std::vector<Real> sum, vol, averaged = values;
+		stages::binPointsByCell(box.grid, s, bins);
+		stages::sumOverCells(bins, s, values, sum, vol);
+		ASSERT_EQ(sum.size(), cells);
+		for (std::size_t c = 0; c < cells; ++c) {
+			EXPECT_EQ(sum[c], referenceSum[c]) << "cell " << c << ", " << threads << " threads";
+			EXPECT_EQ(vol[c], referenceVolume[c]) << "cell " << c << ", " << threads << " threads";
+		}
+		stages::averageOverCells(bins, s, averaged, sum, vol);
+		std::vector<Real> keptSum(cells, 0);
+		for (std::size_t p = 0; p < s.size(); ++p) {
+			EXPECT_EQ(averaged[p], referenceSum[cellOfPoint[p]] / referenceVolume[cellOfPoint[p]]);
+			keptSum[cellOfPoint[p]] += s.volume[p] * averaged[p];
+		}
+		for (std::size_t c = 0; c < cells; ++c) EXPECT_NEAR(keptSum[c], referenceSum[c], 1e-12 * std::max<Real>(1, referenceVolume[c] * 5));
+	}
+	omp_set_num_threads(threadsBefore);
 }
 
 } // namespace
