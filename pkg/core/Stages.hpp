@@ -52,7 +52,6 @@ struct ScatterWorkspace {
 	std::vector<Vec3>                      contactVelocity; // the contact nodes' velocity kept through the re-map
 };
 
-// Scratch of the over-nonlocal softening (theory.md eq. 7.1c): per grid cell (indexed by its lower node).
 // Points of one set grouped by the grid cell that holds them (stages::binPointsByCell): the cell
 // averages (eq. 4.17) and the nonlocal integrals (eq. 7.1c) then sum cell by cell without atomics.
 struct CellBins {
@@ -61,6 +60,7 @@ struct CellBins {
 	std::vector<std::size_t> point; // point indices grouped by cell, ascending within a cell
 };
 
+// Scratch of the over-nonlocal softening (theory.md eq. 7.1c): per grid cell (indexed by its lower node).
 struct NonlocalScratch {
 	std::vector<Real> strain, volume; // Σ V κ and Σ V per cell, then their Gaussian convolutions
 	CellBins          bins;           // the points by cell
