@@ -217,13 +217,15 @@ namespace stages {
 			const std::array<int, 3> c = cellOf(grid, P.position[p]);
 			bins.cell[p]               = grid.index(c[0], c[1], c[2]);
 		}
-		// counting sort: one serial pass to count, one to place (O(N), in point order)
+		// counting sort, serial and O(N): count, prefix sum, place in point order with first[c] as the
+		// cursor (which leaves it at the next cell's start), then shift the offsets back by one cell
 		bins.first.assign(cells + 1, 0);
 		for (std::size_t p = 0; p < count; ++p) ++bins.first[bins.cell[p] + 1];
 		for (std::size_t c = 0; c < cells; ++c) bins.first[c + 1] += bins.first[c];
 		bins.point.resize(count);
-		std::vector<std::size_t> next(bins.first.begin(), bins.first.end() - 1);
-		for (std::size_t p = 0; p < count; ++p) bins.point[next[bins.cell[p]]++] = p;
+		for (std::size_t p = 0; p < count; ++p) bins.point[bins.first[bins.cell[p]]++] = p;
+		for (std::size_t c = cells; c > 0; --c) bins.first[c] = bins.first[c - 1];
+		bins.first[0] = 0;
 	}
 
 	void sumOverCells(const CellBins& bins, const MaterialPointSet& P, const std::vector<Real>& values, std::vector<Real>& cellSum,
