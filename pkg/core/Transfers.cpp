@@ -112,17 +112,34 @@ namespace stages {
 				Real n = 0;
 				Vec3 gradN = Vec3::Zero();
 				bool soil  = false;
-				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
-					n += N * nodalPorosity[I];
-					gradN += nodalPorosity[I] * dN;
-					soil = soil || (N > 0 && nodalPorosity[I] < 1);
-				});
+				if (pressureForces)
+					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
+						n += N * nodalPorosity[I];
+						gradN += nodalPorosity[I] * dN;
+						soil = soil || (N > 0 && nodalPorosity[I] < 1);
+					});
+				else
+					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+						n += N * nodalPorosity[I];
+						soil = soil || (N > 0 && nodalPorosity[I] < 1);
+					});
 				// free water is n = 1 exactly (the sum of the weights is 1 only to round-off)
 				n              = soil ? std::clamp<Real>(n, minimumInterpolatedPorosity, 1) : 1;
 				P.porosity[p]  = n;
-				const Real m = P.mass[p], V = P.volume[p], pressure = pressureForces ? P.porePressure[p] : 0;
+				const Real m = P.mass[p], V = P.volume[p];
 				const Vec3 weight = submerged ? Vec3::Zero() : Vec3(m * gravity); // eq. 1.9
 				const Vec3 mv     = m * P.velocity[p];
+				if (!pressureForces) { // semi-implicit: the pressure's forces come from the projection (eq. 8.1); these stay 0
+					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+						WaterNode& node = nodes[I];
+						node.mass += N * m;
+						node.momentum += N * mv;
+						node.weight += N * weight;
+						node.volume += N * V;
+					});
+					return;
+				}
+				const Real pressure = P.porePressure[p];
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 					WaterNode& node = nodes[I];
 					node.mass += N * m;
