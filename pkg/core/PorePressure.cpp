@@ -204,12 +204,17 @@ namespace stages {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, P, p, w);
 			Real divS = 0, divW = 0;
+			if (!pressureRate) { // semi-implicit: the volume only (S4), the skeleton's divergence unused
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) { divW += waterVelocity[I].dot(dN); });
+				waterDivergence[p] = divW;
+				continue;
+			}
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) {
 				divS += solidVelocity[I].dot(dN);
 				divW += waterVelocity[I].dot(dN);
 			});
 			const Real n = P.porosity[p];
-			if (pressureRate) (*pressureRate)[p] = -(Kw / n) * ((1 - n) * divS + n * divW); // eq. 4.16
+			(*pressureRate)[p] = -(Kw / n) * ((1 - n) * divS + n * divW); // eq. 4.16
 			waterDivergence[p] = divW;
 		}
 	}
