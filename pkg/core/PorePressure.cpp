@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 namespace mpm {
 
@@ -199,24 +200,27 @@ namespace stages {
 		const std::size_t count = P.size();
 		if (pressureRate) pressureRate->resize(count);
 		waterDivergence.resize(count);
+		// with or without the rate, chosen at compile time (semi-implicit S4 reads ∇·v^w only)
+		auto divergences = [&](auto withRate) {
+			constexpr bool rate = decltype(withRate)::value;
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t p = 0; p < count; ++p) {
-			Weights1D w[3];
-			weightsAt<Kernel>(grid, P, p, w);
-			Real divS = 0, divW = 0;
-			if (!pressureRate) { // semi-implicit: the volume only (S4), the skeleton's divergence unused
-				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) { divW += waterVelocity[I].dot(dN); });
+			for (std::size_t p = 0; p < count; ++p) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P, p, w);
+				Real divS = 0, divW = 0;
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) {
+					if constexpr (rate) divS += solidVelocity[I].dot(dN);
+					divW += waterVelocity[I].dot(dN);
+				});
+				if constexpr (rate) {
+					const Real n          = P.porosity[p];
+					(*pressureRate)[p] = -(Kw / n) * ((1 - n) * divS + n * divW); // eq. 4.16
+				}
 				waterDivergence[p] = divW;
-				continue;
 			}
-			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) {
-				divS += solidVelocity[I].dot(dN);
-				divW += waterVelocity[I].dot(dN);
-			});
-			const Real n = P.porosity[p];
-			(*pressureRate)[p] = -(Kw / n) * ((1 - n) * divS + n * divW); // eq. 4.16
-			waterDivergence[p] = divW;
-		}
+		};
+		if (pressureRate) divergences(std::true_type {});
+		else divergences(std::false_type {});
 	}
 
 	void updatePorePressure(const std::vector<Real>& pressureRate, WaterPointSet& P, Real dt)
