@@ -1,8 +1,18 @@
 """Shared fixtures: YADE boots once in the pytest process (Debian's /usr/bin/python3); tests that
-need a fresh process (import routes, loading files, the guard) run scripts in subprocesses."""
+need a fresh process (import routes, loading files, the guard) run scripts in subprocesses.
+
+The quick sand-pile example (test_sandpile_example.py, about six minutes on two cores) is started in
+the background as soon as the tests are collected and its tests are run last, so that it runs beside
+all the others instead of after them. Both processes then share the two cores: their OpenMP threads
+wait passively (a spinning thread at a barrier holds the core the other process needs)."""
 import os
+
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # before YADE (and its OpenMP runtime) loads
+
+import shutil
 import subprocess
 import sys
+import tempfile
 import textwrap
 
 import pytest
@@ -37,3 +47,40 @@ def env_without_build_tree():
     """The environment of a user: no PYTHONPATH, so only the installed yade_mpm can be found."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "MPM_BUILD_DIR")}
     return env
+
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SANDPILE_EXAMPLE_TESTS = "test_sandpile_example.py"
+_background = {}
+
+
+def start_quick_sandpile():
+    """Start (once) the quick sand-pile example in a fresh YADE process writing to a temporary
+    directory; returns (process, output directory). test_sandpile_example.py waits for it."""
+    if "sandpile" not in _background:
+        out = tempfile.mkdtemp(prefix="mpm-quick-sandpile-")
+        env = dict(os.environ, HOME=out)
+        log = open(os.path.join(out, "run.log"), "w")
+        process = subprocess.Popen([YADE, "-j2", "-n", "-x", os.path.join(ROOT, "examples", "sandpile", "sandpile.py"), "--quick", "--out", out],
+                                   stdout=log, stderr=subprocess.STDOUT, text=True, env=env, stdin=subprocess.DEVNULL)
+        _background["sandpile"] = (process, out, log)
+    process, out, _ = _background["sandpile"]
+    return process, out
+
+
+def pytest_collection_modifyitems(session, config, items):
+    example = [item for item in items if item.fspath.basename == SANDPILE_EXAMPLE_TESTS]
+    if not example:
+        return
+    items[:] = [item for item in items if item.fspath.basename != SANDPILE_EXAMPLE_TESTS] + example
+    start_quick_sandpile()
+
+
+def pytest_sessionfinish(session, exitstatus):
+    if "sandpile" in _background:
+        process, out, log = _background.pop("sandpile")
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+        log.close()
+        shutil.rmtree(out, ignore_errors=True)

@@ -7,24 +7,29 @@ last record)."""
 import csv
 import json
 import math
-import os
+import pathlib
 import subprocess
 
 import numpy as np
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from conftest import start_quick_sandpile
+
 OUTPUTS = ["summary.json", "time_series.csv", "time_series.png", "pore_pressure.png", "velocity_at_failure.png", "shear_band.png",
            "sandpile.h5", "sandpile.xmf"]
 
 
 @pytest.fixture(scope="module")
-def quick_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("sandpile")
-    env = dict(os.environ, HOME=str(out))
-    done = subprocess.run(["yade-double", "-j2", "-n", "-x", os.path.join(ROOT, "examples", "sandpile", "sandpile.py"), "--quick",
-                           "--out", str(out)], capture_output=True, text=True, timeout=900, env=env, stdin=subprocess.DEVNULL)
-    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+def quick_run():
+    # started in the background when the tests were collected (conftest.py); these tests run last
+    process, out = start_quick_sandpile()
+    try:
+        returncode = process.wait(timeout=900)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        raise
+    out = pathlib.Path(out)
+    assert returncode == 0, (out / "run.log").read_text()[-6000:]
     with open(out / "summary.json") as f:
         summary = json.load(f)
     with open(out / "time_series.csv") as f:
