@@ -16,6 +16,7 @@ import subprocess
 import sys
 import tempfile
 import textwrap
+import time
 
 import pytest
 
@@ -53,26 +54,29 @@ def env_without_build_tree():
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SANDPILE_EXAMPLE_TESTS = "test_sandpile_example.py"
-_background = {}
+QUICK_SANDPILE_TIMEOUT = 900  # s from its start: the quick mode takes about 7 min on one thread
+_quick_sandpile = None  # (process, output directory, log file, start time) once started
 
 
 def start_quick_sandpile():
     """Start (once) the quick sand-pile example in a fresh YADE process writing to a temporary
-    directory; returns (process, output directory). test_sandpile_example.py waits for it."""
-    if "sandpile" not in _background:
+    directory; returns (process, output directory, seconds left of its timeout). A launch that fails
+    raises here, to the collection hook (which lets it pass) and again to the example's tests."""
+    global _quick_sandpile
+    if _quick_sandpile is None:
         out = tempfile.mkdtemp(prefix="mpm-quick-sandpile-")
-        env = dict(os.environ, HOME=out)
         log = open(os.path.join(out, "run.log"), "w")
         try:
             process = subprocess.Popen([YADE, "-j1", "-n", "-x", os.path.join(ROOT, "examples", "sandpile", "sandpile.py"), "--quick", "--out", out],
-                                       stdout=log, stderr=subprocess.STDOUT, text=True, env=env, stdin=subprocess.DEVNULL)
-        except OSError as error:  # reported by the tests that need the run, not by the collection
-            process = error
-        _background["sandpile"] = (process, out, log)
-    process, out, _ = _background["sandpile"]
-    if isinstance(process, OSError):
-        raise process
-    return process, out
+                                       stdout=log, stderr=subprocess.STDOUT, text=True, env=dict(os.environ, HOME=out),
+                                       stdin=subprocess.DEVNULL)
+        except OSError:
+            log.close()
+            shutil.rmtree(out, ignore_errors=True)
+            raise
+        _quick_sandpile = (process, out, log, time.monotonic())
+    process, out, _, started = _quick_sandpile
+    return process, out, QUICK_SANDPILE_TIMEOUT - (time.monotonic() - started)
 
 
 def pytest_collection_modifyitems(session, config, items):
@@ -83,13 +87,15 @@ def pytest_collection_modifyitems(session, config, items):
     try:
         start_quick_sandpile()
     except OSError:
-        pass  # the example's tests report it
+        pass  # the example's tests start it again and report the error
 
 
 def pytest_sessionfinish(session, exitstatus):
-    if "sandpile" in _background:
-        process, out, log = _background.pop("sandpile")
-        if not isinstance(process, OSError) and process.poll() is None:
+    global _quick_sandpile
+    if _quick_sandpile is not None:
+        process, out, log, _ = _quick_sandpile
+        _quick_sandpile = None
+        if process.poll() is None:
             process.kill()
             process.wait()
         log.close()

@@ -22,9 +22,9 @@ OUTPUTS = ["summary.json", "time_series.csv", "time_series.png", "pore_pressure.
 @pytest.fixture(scope="module")
 def quick_run():
     # started in the background when the tests were collected (conftest.py); these tests run last
-    process, out = start_quick_sandpile()
+    process, out, left = start_quick_sandpile()
     try:
-        returncode = process.wait(timeout=900)
+        returncode = process.wait(timeout=max(left, 0))
     except subprocess.TimeoutExpired:
         process.kill()
         raise
