@@ -8,7 +8,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <utility>
 
@@ -886,6 +888,66 @@ TEST(Charny, DISABLED_StudyHistory)
 		} catch (const InstabilityError& e) {
 			std::printf("  stopped: %s\n", e.what());
 		}
+	}
+}
+
+} // namespace
+
+namespace {
+
+// Not a test: the study behind theory.md §8 Open ("A sloping phreatic surface at rest is an energy
+// source"). A closed box of soil L = 0.4 m long, 0.3 m high (h = 2.5 cm, 2 points per cell, k = 0.01 m/s,
+// E = 10 MPa, every wall impermeable, the end walls and the base fixed) saturated below a plane table
+// normal to a gravity tilted by β about y (the table through x = L/2, z = MPM_TABLE_Z, default 0.1625 m:
+// mid-cell at β = 0), dry above, the water started hydrostatic, the skeleton unstressed (its settling
+// is a transient of a few 1e-6 m/s). At rest the water must come to rest and its potential energy
+// Σ m g·x can only fall, the drag dissipating; printed per 0.25 s with the water's speeds. A sloping
+// table leaves a staircase of points that relaxes by Darcy flow; a surface condition that puts energy
+// in keeps the water moving and its potential energy rising. MPM_TILT [degrees, default 15],
+// MPM_STUDY_END [s, default 6]; about 30 s of CPU per simulated second:
+//   MPM_TILT=15 mpm_benchmark_tests --gtest_also_run_disabled_tests --gtest_filter=TiltedTable.DISABLED_StudyWaterComesToRest
+TEST(TiltedTable, DISABLED_StudyWaterComesToRest)
+{
+	const double g = 9.81, L = 0.4, H = 0.3, h = 0.025, k = 0.01, pi = std::acos(-1.0);
+	auto         setting = [](const char* name, double fallback) { return std::getenv(name) ? std::atof(std::getenv(name)) : fallback; };
+	const double beta = setting("MPM_TILT", 15) * pi / 180, end = setting("MPM_STUDY_END", 6);
+	SoilParameters  soil;
+	WaterParameters water;
+	soil.youngModulus          = 1e7;
+	soil.intrinsicPermeability = k * water.viscosity / (water.density * g);
+	const Vec3    up(-std::sin(beta), 0, std::cos(beta)), centre(L / 2, h / 2, setting("MPM_TABLE_Z", 0.1625));
+	auto          height = [&](const Vec3& x) { return (x - centre).dot(up); }; // above the table
+	const auto    l      = fixtures::lattice(Vec3::Zero(), Vec3(L, h, H), h, 2);
+	SolidPointSet solid  = fixtures::solidLattice(l, soil.porosity, soil.density);
+	WaterPointSet fluid  = fixtures::waterLattice(fixtures::latticeWhere(l, [&](const Vec3& x) { return height(x) < 0; }), soil.porosity, water.density);
+	for (std::size_t p = 0; p < fluid.size(); ++p) fluid.porePressure[p] = -water.density * g * height(fluid.position[p]);
+	Domain d = fixtures::columnDomain(Vec3(L, h, H + 2 * h), h);
+	d.boundaries.walls[static_cast<int>(Face::XMin)] = d.boundaries.walls[static_cast<int>(Face::XMax)] = { SolidWall::Fixed, WaterWall::Impermeable };
+	d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Drained, 0.0 };
+	SolverSettings s;
+	s.gravity = -g * up;
+	s.scheme  = TimeScheme::SemiImplicit;
+	TwoPhaseSolver solver(d, s);
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	std::printf("tilt %.1f deg, %zu water points, k %g m/s\n", beta * 180 / pi, fluid.size(), k);
+	try {
+		for (double t = 0.25; t <= end + 1e-9; t += 0.25) {
+			solver.advance(0.25);
+			double fastest = 0, mean = 0, potential = 0, solidFastest = 0;
+			Vec3   where = Vec3::Zero();
+			for (std::size_t p = 0; p < fluid.size(); ++p) {
+				const double v = fluid.velocity[p].norm();
+				if (v > fastest) fastest = v, where = fluid.position[p];
+				mean += v / fluid.size();
+				potential += fluid.mass[p] * g * height(fluid.position[p]);
+			}
+			for (std::size_t p = 0; p < solid.size(); ++p) solidFastest = std::max(solidFastest, solid.velocity[p].norm());
+			std::printf("  t %5.2f s: water |v| mean %.3e, largest %.3e m/s at x %.3f, z %.3f (%+.3f m from the table); water potential energy %.7e J; solid |v| largest %.2e m/s\n", t,
+			            mean, fastest, where.x(), where.z(), height(where), potential, solidFastest);
+			std::fflush(stdout);
+		}
+	} catch (const InstabilityError& e) {
+		std::printf("  stopped: %s\n", e.what());
 	}
 }
 
