@@ -846,8 +846,8 @@ void TwoPhaseSolver::injectInflowingWater()
 			// there lies outside the skeleton and leaves at once, eq. 1.9 — the first submerged pile
 			// pumped 71 kg in and out that way)
 			inflowSoil_.assign(rows1 * rows2, 0);
-			for (const SolidSet& set : solids_) {
-				const SolidPointSet& S = *set.points;
+			for (const SolidSet& skeleton : solids_) {
+				const SolidPointSet& S = *skeleton.points;
 				for (std::size_t p = 0; p < S.size(); ++p) {
 					const Vec3& x = S.position[p];
 					const Vec3& l = S.halfLength[p];

@@ -13,7 +13,6 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # before YADE (and its Open
 
 import shutil
 import subprocess
-import sys
 import tempfile
 import textwrap
 import time
