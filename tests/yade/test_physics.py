@@ -394,8 +394,8 @@ def test_dry_above_table_start_is_geostatic():
 @pytest.mark.xfail(strict=True, reason="a phreatic surface inside the soil leaks on the semi-implicit step (theory.md §8 Open): "
                                        "the water table of this column at rest descends at 2.9e-4 m/s (0.3 k) with pressureCorrections = 0, "
                                        "5e-5 m/s with 2; its top points read 106-109 Pa where hydrostatic is 124 Pa. Both causes are found "
-                                       "(the mobility of partly wet nodes, dry solid points taking pore pressure) and fixed on a branch, "
-                                       "exact at rest there, but not merged: Charny's dam loses 16% of its inflow with them")
+                                       "(the mobility of partly wet nodes, dry solid points taking pore pressure); fixing both makes this "
+                                       "column exact at rest but costs Charny's dam 16% of its inflow, so the fix is not merged")
 def test_phreatic_surface_inside_the_soil_stays_at_rest():
     """A column dry above its water table (0.3 m of 0.5 m), semi-implicit, k = 1e-3 m/s: at rest,
     the water's speeds must stay below 1e-5 m/s (a thousandth of k) over 0.2 s and p within 2% of
