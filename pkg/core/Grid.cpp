@@ -42,6 +42,7 @@ void GridFields::resize(std::size_t n)
 	solid.resize(n);
 	water.resize(n);
 	porosity.resize(n);
+	dragSupport.resize(n, 1);
 	solidVelocity.resize(n);
 	waterVelocity.resize(n);
 	solidVelocityNew.resize(n);

@@ -168,6 +168,7 @@ struct GridFields {
 	std::vector<SolidNode> solid;
 	std::vector<WaterNode> water;
 	std::vector<Real>      porosity;         // n_I = 1 − (grain volume)/(mixture volume) [-]
+	std::vector<Real>      dragSupport;      // V^w_I/V_I where the drag is limited to the water-sampled support (eq. 4.7b), else 1 [-]
 	std::vector<Vec3>      solidVelocity;    // v^s_I at t^n [m s⁻¹]
 	std::vector<Vec3>      waterVelocity;    // v^w_I at t^n [m s⁻¹]
 	std::vector<Vec3>      solidVelocityNew; // v^s_I at t^{n+1}, then the MUSL remapped v̂^s [m s⁻¹]

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <type_traits>
 
@@ -235,6 +236,25 @@ namespace stages {
 		const std::size_t count = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) P.volume[p] *= 1 + dt * waterDivergence[p];
+	}
+
+	void fillPoresNextToInflowFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const WaterParameters& water, WaterPointSet& P)
+	{
+		std::array<Real, faceCount> plane {};
+		bool                        any = false;
+		for (int f = 0; f < faceCount; ++f) {
+			plane[f] = f % 2 ? grid.upper()[f / 2] : grid.lower()[f / 2];
+			any      = any || bcs.walls[f].inflow;
+		}
+		if (!any) return;
+		const Real        invKw = 1 / water.bulkModulus; // 0 for incompressible water
+		const std::size_t count = P.size();
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			bool near = false;
+			for (int f = 0; f < faceCount && !near; ++f) near = bcs.walls[f].inflow && std::abs(P.position[p][f / 2] - plane[f]) < grid.cellSize;
+			if (near) P.volume[p] = P.mass[p] / (P.porosity[p] * water.density * (1 + P.porePressure[p] * invKw));
+		}
 	}
 
 	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& P,

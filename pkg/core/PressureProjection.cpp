@@ -70,6 +70,16 @@ namespace {
 			}
 	}
 
+	// The share of the skeleton's support at node I that the water fills, min(1, V^w_I/V_I) (0 without
+	// skeleton), and the filling from which a solid point counts as wet (theory.md eq. 8.1c): its
+	// interpolation Σ S_I min(1, V^w_I/V_I) at the point at least one half.
+	inline Real skeletonWetting(const GridFields& fields, std::size_t I)
+	{
+		const Real V = fields.solid[I].volume;
+		return V > 0 ? std::min<Real>(1, fields.water[I].volume / V) : 0;
+	}
+	constexpr Real wetSolidPointFilling = 0.5;
+
 	// Filling of node I: its water points' volume over its in-domain support, 0 without support.
 	inline Real nodeFilling(const GridGeometry& grid, const GridFields& fields, const std::array<int, 3>& idx)
 	{
@@ -242,19 +252,23 @@ namespace stages {
 		for (std::size_t I = 0; I < nodes; ++I) {
 			const SolidNode& sn = fields.solid[I];
 			const bool       hasS = sn.mass > solidMassTolerance && sn.solidVolume > 0 && sn.volume > 0;
-			system.mobility[I]    = Vec3::Constant(hasS ? pressureMobility(fields.porosity[I], sn.mass / sn.solidVolume, rhoWater, sn.drag * dt / sn.volume)
-			                                            : 1 / rhoWater);
+			// per unit of the water-sampled support, where the water fills the skeleton's support only in
+			// part (eq. 8.5c): the skeleton's mass and the drag over V^w_I, as the forces they answer
+			const Real perWater = hasS ? 1 / fields.dragSupport[I] : 1;
+			system.mobility[I]  = Vec3::Constant(hasS ? pressureMobility(fields.porosity[I], perWater * sn.mass / sn.solidVolume, rhoWater, perWater * sn.drag * dt / sn.volume)
+			                                          : 1 / rhoWater);
 		}
 		for (std::size_t c = 0; c < constrained.node.size(); ++c) {
 			const std::size_t     I  = constrained.node[c];
 			const SolidNode&      sn = fields.solid[I];
 			const bool hasS = sn.mass > solidMassTolerance && sn.solidVolume > 0 && sn.volume > 0, hasW = fields.water[I].mass > waterMassTolerance;
 			const Real n = hasS ? fields.porosity[I] : 1;
+			const Real perWater = hasS ? 1 / fields.dragSupport[I] : 1; // eq. 8.5c
 			for (int d = 0; d < 3; ++d) {
 				const bool solidHeld = hasS && heldSolid[c][d], waterHeld = constrained.constraint[c].water[d];
 				if (solidHeld && waterHeld) system.mobility[I][d] = 0;
-				else if (solidHeld) system.mobility[I][d] = hasW ? n * n / (n * rhoWater + sn.drag * dt / sn.volume) : 0; // water dragged past held grains
-				else if (waterHeld) system.mobility[I][d] = hasS ? sn.solidVolume / sn.mass : 0;                          // 1/ρs: the grains take the whole force
+				else if (solidHeld) system.mobility[I][d] = hasW ? n * n / (n * rhoWater + perWater * sn.drag * dt / sn.volume) : 0; // water dragged past held grains
+				else if (waterHeld) system.mobility[I][d] = hasS ? sn.solidVolume / (perWater * sn.mass) : 0;                          // 1/ρs: the grains take the whole force
 			}
 		}
 		// the velocities the pressure forces act on (eqs. 8.1–8.2): the skeleton's share at the solid
@@ -333,14 +347,16 @@ namespace stages {
 			scatter(system.rows, system.rowBuffers, P.size(), [&](std::size_t p, Real* rows) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
-				Real n = 0, divS = 0;
+				Real n = 0, divS = 0, wet = 0;
 				bool reaches = false;
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 					n += N * fields.porosity[I];
 					divS += system.solidPointVelocity[I].dot(dN);
+					wet += N * skeletonWetting(fields, I);
 					reaches = reaches || system.row[I] >= 0;
 				});
-				if (!reaches) return;
+				// a dry solid point's volume change moves air, not water (eq. 8.1c)
+				if (!reaches || wet < wetSolidPointFilling) return;
 				// (1 − n) S_J ∇·vs: the skeleton's share of the mixture's volume change
 				n                 = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 				const Real source = P.volume[p] * (1 - n) * divS;
@@ -364,12 +380,13 @@ namespace stages {
 		auto add = [&](const Vec3& x, const Vec3& halfLength, Real volume, bool water) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, x, halfLength, w);
-			Real D = 0, n = 0;
+			Real D = 0, n = 0, wet = 0;
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 				n += N * fields.porosity[I];
+				wet += N * skeletonWetting(fields, I);
 				if (onPlate[I]) D += dN[axis];
 			});
-			if (D == 0) return;
+			if (D == 0 || (!water && wet < wetSolidPointFilling)) return; // eq. 8.1c: dry solid points take no part
 			n                 = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 			const Real factor = volume * (water ? n : 1 - n) * D;
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
@@ -625,11 +642,13 @@ namespace stages {
 			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
-				Real q = 0, n = 0;
+				Real q = 0, n = 0, wet = 0;
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 					q += N * pressure[I];
 					n += N * fields.porosity[I];
+					wet += N * skeletonWetting(fields, I);
 				});
+				if (wet < wetSolidPointFilling) return; // eq. 8.1c: no pore water acts on dry grains
 				n             = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 				const Real Vq = P.volume[p] * q * (1 - n);
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3& dN) { nodes[I].solid += Vq * dN; });
@@ -809,11 +828,13 @@ namespace stages {
 				scatter(balance, balanceBuffers, P.size(), [&](std::size_t p, Real* rows) {
 					Weights1D w[3];
 					weightsAt<Kernel>(grid, P, p, w);
-					Real nn = 0, div = 0;
+					Real nn = 0, div = 0, wet = 0;
 					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 						nn += N * fields.porosity[I];
 						div += skeleton[I].dot(dN);
+						wet += N * skeletonWetting(fields, I);
 					});
+					if (wet < wetSolidPointFilling) return; // eq. 8.1c, as the assembly
 					nn                = std::clamp<Real>(nn, minimumInterpolatedPorosity, 1);
 					const Real source = P.volume[p] * (1 - nn) * div;
 					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {

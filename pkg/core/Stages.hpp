@@ -272,6 +272,11 @@ namespace stages {
 	Real skeletonFilling(const GridGeometry& grid, const GridFields& fields, const Vec3& position);
 	// Advance the water points' volume with the (possibly cell-averaged) divergence: V ← V (1 + Δt ∇·v^w).
 	void updateWaterVolume(const std::vector<Real>& waterDivergence, WaterPointSet& points, Real dt);
+	// Semi-implicit step, next to an inflow face (theory.md eq. 8.9c): the water points whose centre lies
+	// within one cell of a face with waterInflow take the volume of the state, V = m/(n ρw (1 + p/Kw)),
+	// n the step's porosity at the point; the face's nodes keep no volume balance, so there the rate form
+	// would integrate a divergence that nothing holds.
+	void fillPoresNextToInflowFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const WaterParameters& water, WaterPointSet& points);
 
 	// Free surface (theory.md eq. 2.3): p = 0 on water points whose filling Σ S_I V^w_I/V^full_I
 	// (nodal water-point volume over the node's full in-domain support volume) is below `threshold`;

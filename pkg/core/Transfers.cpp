@@ -85,9 +85,11 @@ namespace stages {
 	void limitDragToWetSupport(const GridGeometry& grid, const BoundaryConditions& bcs, GridFields& fields)
 	{
 		const std::size_t nodes = fields.solid.size();
+		fields.dragSupport.resize(nodes);
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 		for (std::size_t i = 0; i < nodes; ++i) {
 			const Real V = fields.solid[i].volume, Vw = fields.water[i].volume;
+			fields.dragSupport[i] = 1;
 			if (!(V > 0) || Vw >= V) continue;
 			// a drained face saturates the soil on its plane (p̄ ≥ 0); its water points are cut as
 			// they cross it (eq. 2.4), so there they sample the water only in part
@@ -95,7 +97,9 @@ namespace stages {
 			bool onDrainedFace = false;
 			for (int face = 0; face < 6 && !onDrainedFace; ++face)
 				onDrainedFace = bcs.walls[face].water == WaterWall::Drained && grid.atWall(face / 2, face % 2, idx[face / 2], 1);
-			if (!onDrainedFace) fields.solid[i].drag *= Vw / V;
+			if (onDrainedFace) continue;
+			fields.solid[i].drag *= Vw / V;
+			if (Vw > 0) fields.dragSupport[i] = Vw / V; // the mobility's support (eq. 8.5c); a node without water has none
 		}
 	}
 

@@ -632,6 +632,7 @@ template <class Kernel> void TwoPhaseSolver::updateWater(Real dt, bool semiImpli
 		}
 		if (!semiImplicit) updatePorePressure(pressureRate_, *w, dt);
 		updateWaterVolume(waterDivergence_, *w, dt);
+		if (semiImplicit) fillPoresNextToInflowFaces(grid_, domain_.boundaries, water_, *w); // eq. 8.9c
 		// semi-implicit: the points carry the interpolated solution, which holds the faces and the
 		// free surface at their nodes (theory.md §8.5); explicit: relaxations and resets (eqs. 4.17b–c, 2.1, 2.3)
 		if (semiImplicit) continue;

@@ -273,3 +273,40 @@ TEST(CellAverage, SumsEachCellInPointOrderForAnyThreadCount)
 }
 
 } // namespace
+
+namespace {
+
+// theory.md eq. 8.9c: within one cell of an inflow face the reservoir fills the pores, so a water
+// point's volume is the state's, V = m/(n ρw (1 + p/Kw)); a point a cell or more from it, or next to a
+// drained face without inflow, keeps the volume it had (the rate form's).
+TEST(InflowFacePores, PointsWithinACellOfAnInflowFaceTakeTheStateVolume)
+{
+	using namespace mpm;
+	const GridGeometry grid = GridGeometry::forDomain(Vec3(0, 0, 0), Vec3(0.4, 0.1, 0.3), 0.1);
+	BoundaryConditions bcs;
+	bcs.walls[static_cast<int>(Face::XMin)] = { SolidWall::Slip, WaterWall::Drained, 0.0 };
+	bcs.walls[static_cast<int>(Face::XMin)].inflow = true;
+	bcs.walls[static_cast<int>(Face::XMax)] = { SolidWall::Slip, WaterWall::Drained, 0.0 }; // drained, no inflow
+	WaterParameters water;
+	const auto      lattice = fixtures::lattice(Vec3(0, 0, 0), Vec3(0.4, 0.1, 0.1), 0.1, 2);
+	WaterPointSet   P       = fixtures::waterLattice(lattice, 0.4, water.density);
+	for (std::size_t p = 0; p < P.size(); ++p) {
+		P.volume[p] *= 1.2; // a drifted rate-form volume
+		P.porosity[p]     = 0.35 + 0.1 * P.position[p].z();
+		P.porePressure[p] = 1e4 * (1 + p % 3);
+	}
+	const WaterPointSet before = P;
+	stages::fillPoresNextToInflowFaces(grid, bcs, water, P);
+	int near = 0;
+	for (std::size_t p = 0; p < P.size(); ++p) {
+		if (P.position[p].x() < grid.cellSize) {
+			++near;
+			EXPECT_NEAR(P.volume[p], P.mass[p] / (P.porosity[p] * water.density * (1 + P.porePressure[p] / water.bulkModulus)), 1e-15 * P.volume[p]);
+		} else
+			EXPECT_EQ(P.volume[p], before.volume[p]); // farther in, and next to the drained face without inflow
+		EXPECT_EQ(P.mass[p], before.mass[p]);
+	}
+	EXPECT_EQ(near, 8); // the lattice's first two point columns (2 × 2 × 2 points per cell)
+}
+
+} // namespace
