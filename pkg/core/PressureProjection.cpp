@@ -72,7 +72,8 @@ namespace {
 
 	// The share of the skeleton's support at node I that the water fills, min(1, V^w_I/V_I) (0 without
 	// skeleton), and the filling from which a solid point counts as wet (theory.md eq. 8.1c): its
-	// interpolation Σ S_I min(1, V^w_I/V_I) at the point at least one half.
+	// interpolation Σ S_I min(1, V^w_I/V_I) at the point at least one half — what it is, about, at a point on a
+	// plane water table (a node on the table is half filled), so the points below a table are wet and those above it dry.
 	inline Real skeletonWetting(const GridFields& fields, std::size_t I)
 	{
 		const Real V = fields.solid[I].volume;
