@@ -800,7 +800,8 @@ namespace {
 // what is tested is the steady balance and the convergence. The outflow leaves in chunks of cut points
 // (±5% per 2 s window), so in = out is asserted over the long window. Before eqs. 8.5c, 8.1c and 8.9c
 // this test read in −0.38%, out −0.01% over 10–13 s, but the dam was not steady: its inflow face's
-// water points swelled by the rate form (V/(m/(nρw)) 1.24 at the face's top by 12 s), the inflow
+// water points swelled by the rate form (the face's top node filled 1.24 times by volume, 1.0 by mass,
+// by 12 s), the inflow
 // reversed at the face's foot at 14–16 s and the run stopped unstable at 17.9 s (theory.md §8 Open).
 // The dam above at cell size h (the test and the study below).
 struct CharnyDam {
