@@ -77,6 +77,16 @@ struct BoundaryConditions {
 	Real stillWaterLevel = -std::numeric_limits<Real>::infinity();
 	bool submerged() const { return std::isfinite(stillWaterLevel); }
 
+	// Whether x lies less than one cell inside a face with waterInflow (theory.md eqs. 4.11d, 8.9c).
+	bool withinACellOfInflowFace(const GridGeometry& grid, const Vec3& x) const
+	{
+		for (int f = 0; f < faceCount; ++f) {
+			if (!walls[f].inflow) continue;
+			const int d = f / 2;
+			if ((f % 2 ? grid.upper()[d] - x[d] : x[d] - grid.lower()[d]) < grid.cellSize) return true;
+		}
+		return false;
+	}
 	// Throws InvalidParameter naming the face and the condition if a face of a periodic axis
 	// carries any wall condition (it would be silently ignored).
 	void requireFreePeriodicFaces() const;

@@ -8,7 +8,6 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <type_traits>
 
@@ -240,21 +239,12 @@ namespace stages {
 
 	void fillPoresNextToInflowFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const WaterParameters& water, WaterPointSet& P)
 	{
-		std::array<Real, faceCount> plane {};
-		bool                        any = false;
-		for (int f = 0; f < faceCount; ++f) {
-			plane[f] = f % 2 ? grid.upper()[f / 2] : grid.lower()[f / 2];
-			any      = any || bcs.walls[f].inflow;
-		}
-		if (!any) return;
+		if (std::none_of(bcs.walls.begin(), bcs.walls.end(), [](const WallConditions& w) { return w.inflow; })) return;
 		const Real        invKw = 1 / water.bulkModulus; // 0 for incompressible water
 		const std::size_t count = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t p = 0; p < count; ++p) {
-			bool near = false;
-			for (int f = 0; f < faceCount && !near; ++f) near = bcs.walls[f].inflow && std::abs(P.position[p][f / 2] - plane[f]) < grid.cellSize;
-			if (near) P.volume[p] = P.mass[p] / (P.porosity[p] * water.density * (1 + P.porePressure[p] * invKw));
-		}
+		for (std::size_t p = 0; p < count; ++p)
+			if (bcs.withinACellOfInflowFace(grid, P.position[p])) P.volume[p] = P.mass[p] / (P.porosity[p] * water.density * (1 + P.porePressure[p] * invKw));
 	}
 
 	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& P,

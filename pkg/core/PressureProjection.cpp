@@ -70,15 +70,10 @@ namespace {
 			}
 	}
 
-	// The share of the skeleton's support at node I that the water fills, min(1, V^w_I/V_I) (0 without
-	// skeleton), and the filling from which a solid point counts as wet (theory.md eq. 8.1c): its
-	// interpolation Σ S_I min(1, V^w_I/V_I) at the point at least one half — what it is, about, at a point on a
-	// plane water table (a node on the table is half filled), so the points below a table are wet and those above it dry.
-	inline Real skeletonWetting(const GridFields& fields, std::size_t I)
-	{
-		const Real V = fields.solid[I].volume;
-		return V > 0 ? std::min<Real>(1, fields.water[I].volume / V) : 0;
-	}
+	// The filling from which a solid point counts as wet (theory.md eq. 8.1c): the interpolation
+	// Σ S_I min(1, V^w_I/V_I) at the point (PressureSystem::skeletonWetting) at least one half — what it
+	// is, about, at a point on a plane water table (a node on the table is half filled), so the points
+	// below a table are wet and those above it dry.
 	constexpr Real wetSolidPointFilling = 0.5;
 
 	// Filling of node I: its water points' volume over its in-domain support, 0 without support.
@@ -278,6 +273,7 @@ namespace stages {
 		// acts on the grains over the part θ = min(1, V_I/V^w_I) of the water-sampled support that the
 		// skeleton covers, on the water elsewhere: v^m = θ v^s + (1 − θ) v^w, relative w = θ (v^w − v^s)
 		system.skeletonShare.resize(nodes);
+		system.skeletonWetting.resize(nodes);
 		system.solidPointVelocity.resize(nodes);
 		system.mixtureVelocity.resize(nodes);
 		system.relativeVelocity.resize(nodes);
@@ -288,6 +284,8 @@ namespace stages {
 			const Vec3& vs = fields.solidVelocityNew[I];
 			const Vec3& vw = fields.waterVelocityNew[I];
 			system.skeletonShare[I]      = theta;
+			const Real V                 = fields.solid[I].volume;
+			system.skeletonWetting[I]    = V > 0 ? std::min<Real>(1, fields.water[I].volume / V) : 0;
 			system.solidPointVelocity[I] = hasS ? vs : vw;
 			system.mixtureVelocity[I]    = theta * vs + (1 - theta) * vw;
 			system.relativeVelocity[I]   = theta * (vw - vs);
@@ -353,7 +351,7 @@ namespace stages {
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 					n += N * fields.porosity[I];
 					divS += system.solidPointVelocity[I].dot(dN);
-					wet += N * skeletonWetting(fields, I);
+					wet += N * system.skeletonWetting[I];
 					reaches = reaches || system.row[I] >= 0;
 				});
 				// a dry solid point's volume change moves air, not water (eq. 8.1c)
@@ -384,7 +382,7 @@ namespace stages {
 			Real D = 0, n = 0, wet = 0;
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 				n += N * fields.porosity[I];
-				wet += N * skeletonWetting(fields, I);
+				wet += N * system.skeletonWetting[I];
 				if (onPlate[I]) D += dN[axis];
 			});
 			if (D == 0 || (!water && wet < wetSolidPointFilling)) return; // eq. 8.1c: dry solid points take no part
@@ -647,7 +645,7 @@ namespace stages {
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
 					q += N * pressure[I];
 					n += N * fields.porosity[I];
-					wet += N * skeletonWetting(fields, I);
+					wet += N * system.skeletonWetting[I];
 				});
 				if (wet < wetSolidPointFilling) return; // eq. 8.1c: no pore water acts on dry grains
 				n             = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
@@ -833,7 +831,7 @@ namespace stages {
 					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 						nn += N * fields.porosity[I];
 						div += skeleton[I].dot(dN);
-						wet += N * skeletonWetting(fields, I);
+						wet += N * system.skeletonWetting[I];
 					});
 					if (wet < wetSolidPointFilling) return; // eq. 8.1c, as the assembly
 					nn                = std::clamp<Real>(nn, minimumInterpolatedPorosity, 1);

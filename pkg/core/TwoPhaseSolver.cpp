@@ -655,17 +655,6 @@ void TwoPhaseSolver::updateDomains()
 	for (SolidSet& s : solids_) stages::updateDomainsCpGimp(*s.points, grid_.cellSize);
 }
 
-bool TwoPhaseSolver::nearInflowFace(const Vec3& x) const
-{
-	for (int f = 0; f < faceCount; ++f) {
-		if (!domain_.boundaries.walls[f].inflow) continue;
-		const int  d     = f / 2;
-		const Real plane = f % 2 ? grid_.upper()[d] : grid_.lower()[d];
-		if (std::abs(x[d] - plane) < grid_.cellSize) return true;
-	}
-	return false;
-}
-
 bool TwoPhaseSolver::insideSkeleton(const Vec3& x)
 {
 	const Real h      = grid_.cellSize;
@@ -735,7 +724,7 @@ void TwoPhaseSolver::removeOutflowingWater()
 			// still water, which the model does not carry (weightless, it would pile up on the surface);
 			// not in an inflow face's cell, whose water is the reservoir's (eq. 2.5: removed there, a
 			// buffer in a loosened crest was grown again every step)
-			out = out || (domain_.boundaries.submerged() && !nearInflowFace(w->position[p]) && !skeletonHolds(w->position[p]));
+			out = out || (domain_.boundaries.submerged() && !domain_.boundaries.withinACellOfInflowFace(grid_, w->position[p]) && !skeletonHolds(w->position[p]));
 			// the part of a point beyond a drained face has left through it (eq. 2.4)
 			for (int f = 0; f < faceCount && !out; ++f) {
 				if (domain_.boundaries.walls[f].water != WaterWall::Drained || grid_.periodic[f / 2]) continue;
@@ -954,21 +943,11 @@ void TwoPhaseSolver::markInflowCellPoints()
 		inflowCell_.clear(); // none marked: every point takes flipBlend
 		return;
 	}
-	const Vec3 lower = grid_.lower(), upper = grid_.upper();
 	inflowCell_.resize(waters_.size());
 	for (std::size_t s = 0; s < waters_.size(); ++s) {
 		const WaterPointSet& w = *waters_[s];
 		inflowCell_[s].assign(w.size(), 0);
-		for (std::size_t p = 0; p < w.size(); ++p)
-			for (int f = 0; f < faceCount; ++f) {
-				if (!domain_.boundaries.walls[f].inflow) continue;
-				const int  d     = f / 2;
-				const Real depth = f % 2 ? upper[d] - w.position[p][d] : w.position[p][d] - lower[d];
-				if (depth < grid_.cellSize) {
-					inflowCell_[s][p] = 1;
-					break;
-				}
-			}
+		for (std::size_t p = 0; p < w.size(); ++p) inflowCell_[s][p] = domain_.boundaries.withinACellOfInflowFace(grid_, w.position[p]);
 	}
 }
 

@@ -206,7 +206,6 @@ private:
 	std::vector<std::vector<Vec3>> lossBuffers_;
 	TimeStepLimits                lastLimits_ {};
 	void                          removeOutflowingWater();
-	bool                          nearInflowFace(const Vec3& x) const; // within a cell of a face with waterInflow
 	// Whether the skeleton holds water at x under still water (eq. 1.9: the outflow and the inflow
 	// face's wetting): its nodal filling at x is at least ½, or x lies in a solid point's domain
 	bool                          skeletonHolds(const Vec3& x);
