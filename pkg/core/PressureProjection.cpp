@@ -7,8 +7,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
+#include <type_traits>
 
 namespace mpm {
 
@@ -31,17 +33,39 @@ namespace {
 	// products of the 1D weights: Xv Yv Zv storage + Xg Yv Zv cx + Xv Yg Zv cy + Xv Yv Zg cz = Xv A + Xg B
 	// with A, B per (y, z) pair. Same result as summing the 3D products pair by pair to round-off
 	// (tests/core/test_pressure_projection.cpp).
+	// Lanes of the x-run of a stored row that addPairTerms updates at once: a run of S slots padded
+	// to a vector of 4 (uGIMP) or 2 (linear) doubles. The padding lane carries weight products of 0,
+	// so it adds an exact zero to the next slot of the row (the row's last run ends on the b slot).
+	template <int S> constexpr int pairLanes = S == 3 ? 4 : 2;
+	typedef Real PairLane4 __attribute__((vector_size(4 * sizeof(Real))));
+	typedef Real PairLane2 __attribute__((vector_size(2 * sizeof(Real))));
+	template <int S> using PairLane = std::conditional_t<pairLanes<S> == 4, PairLane4, PairLane2>;
+
 	template <int S>
 	inline void addPairTerms(const GridGeometry& grid, const Weights1D (&w)[3], const int (&node)[3][S], Real storage, const Vec3& conductance,
 	                         const PressureSystem& system, Real* rows)
 	{
+		static_assert(pairLanes<S> >= S && sizeof(PairLane<S>) == pairLanes<S> * sizeof(Real), "a run of S slots fits in one lane vector");
+		using Lane = PairLane<S>;
 		Real xv[S][S], xg[S][S], yv[S][S], yg[S][S], zv[S][S], zg[S][S];
+		Real xvPad[S][pairLanes<S>] = {}, xgPad[S][pairLanes<S>] = {};
 		for (int i = 0; i < S; ++i)
 			for (int j = 0; j < S; ++j) {
 				xv[i][j] = w[0].value[i] * w[0].value[j], xg[i][j] = w[0].gradient[i] * w[0].gradient[j];
 				yv[i][j] = w[1].value[i] * w[1].value[j], yg[i][j] = w[1].gradient[i] * w[1].gradient[j];
 				zv[i][j] = w[2].value[i] * w[2].value[j], zg[i][j] = w[2].gradient[i] * w[2].gradient[j];
+				xvPad[i][j] = xv[i][j], xgPad[i][j] = xg[i][j];
 			}
+		Lane xvLane[S], xgLane[S]; // xv, xg padded with zeros
+		for (int i = 0; i < S; ++i) std::memcpy(&xvLane[i], xvPad[i], sizeof(Lane)), std::memcpy(&xgLane[i], xgPad[i], sizeof(Lane));
+		// slot[0..S) += xv A + xg B in one vector operation (the same products and sums per slot as
+		// the scalar loop: results equal bit for bit)
+		auto addRun = [&](Real* slot, int a, Real A, Real B) {
+			Lane v;
+			std::memcpy(&v, slot, sizeof v);
+			v += xvLane[a] * A + xgLane[a] * B;
+			std::memcpy(slot, &v, sizeof v);
+		};
 		for (int c = 0; c < S; ++c)
 			for (int b = 0; b < S; ++b) {
 				Real A[S][S], B[S][S]; // per (cc, bb): the coefficients of Xv and Xg
@@ -57,15 +81,9 @@ namespace {
 					if (vx * vy * vz == 0 && w[0].gradient[a] * vy * vz == 0 && vx * w[1].gradient[b] * vz == 0 && vx * vy * w[2].gradient[c] == 0) continue;
 					Real* r = rows + static_cast<std::size_t>(system.row[grid.index(node[0][a], node[1][b], node[2][c])]) * PressureSystem::rowStride;
 					for (int aa = a; aa < S; ++aa) r[upperSlot(aa - a, 0, 0)] += xv[a][aa] * A[c][b] + xg[a][aa] * B[c][b]; // same y and z: x ≥ 0
-					for (int bb = b + 1; bb < S; ++bb) {
-						Real* slot = r + upperSlot(-a, bb - b, 0);
-						for (int aa = 0; aa < S; ++aa) slot[aa] += xv[a][aa] * A[c][bb] + xg[a][aa] * B[c][bb];
-					}
+					for (int bb = b + 1; bb < S; ++bb) addRun(r + upperSlot(-a, bb - b, 0), a, A[c][bb], B[c][bb]);
 					for (int cc = c + 1; cc < S; ++cc)
-						for (int bb = 0; bb < S; ++bb) {
-							Real* slot = r + upperSlot(-a, bb - b, cc - c);
-							for (int aa = 0; aa < S; ++aa) slot[aa] += xv[a][aa] * A[cc][bb] + xg[a][aa] * B[cc][bb];
-						}
+						for (int bb = 0; bb < S; ++bb) addRun(r + upperSlot(-a, bb - b, cc - c), a, A[cc][bb], B[cc][bb]);
 				}
 			}
 	}
