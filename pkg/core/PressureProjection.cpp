@@ -774,6 +774,31 @@ namespace stages {
 	}
 
 	template <class Kernel>
+	PressureWork pressureWorkAndBalance(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                                    const WaterParameters& water, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
+	                                    Real solidMassTolerance, Real waterMassTolerance, const std::vector<Real>& pressure, PressureSystem& system)
+	{
+		PressureWork     work;
+		WaterParameters  noStorage = water;
+		noStorage.bulkModulus      = std::numeric_limits<Real>::infinity(); // C = 0: b = −Bᵀv
+		assemblePressureSystem<Kernel>(grid, fields, solids, sets, noStorage, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, system);
+		for (std::size_t r = 0; r < system.node.size(); ++r)
+			work.balance -= pressure[system.node[r]] * system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
+		accumulatePressureForces<Kernel>(grid, fields, solids, sets, pressure, false, system);
+		for (std::size_t I = 0; I < grid.nodeCount(); ++I) {
+			const bool  hasS = fields.solid[I].mass > solidMassTolerance, hasW = fields.water[I].mass > waterMassTolerance;
+			const Vec3& vs = fields.solidVelocityNew[I];
+			const Vec3& vw = fields.waterVelocityNew[I];
+			const Vec3& us = hasS ? vs : vw;
+			const Vec3& uw = hasW ? vw : vs;
+			const PressureForceNode& g = system.forces[I];
+			work.forces += g.solid.dot(us) + g.water.dot(uw);
+			work.scale += g.solid.norm() * us.norm() + g.water.norm() * uw.norm();
+		}
+		return work;
+	}
+
+	template <class Kernel>
 	PressureSolveReport correctPressureDefect(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids,
 	                                          std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs, const Vec3& gravity, const WaterParameters& water,
 	                                          const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, const PlateMotion* plate,
@@ -901,7 +926,10 @@ namespace stages {
 	                                                     Real, Real, int, PressureSystem&);                                                          \
 	template ProjectionForms projectionForms<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&, \
 	                                            const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,                \
-	                                            const std::vector<Real>&, PressureSystem&);
+	                                            const std::vector<Real>&, PressureSystem&);                                                          \
+	template PressureWork pressureWorkAndBalance<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&, \
+	                                                const WaterParameters&, const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real, \
+	                                                const std::vector<Real>&, PressureSystem&);
 
 	MPM_INSTANTIATE_PROJECTION(LinearKernel)
 	MPM_INSTANTIATE_PROJECTION(GimpKernel)

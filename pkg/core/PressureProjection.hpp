@@ -48,6 +48,14 @@ struct ProjectionForms {
 	Real exact   = 0; // Δt pᵀ BᵀM⁻¹B p (+ pᵀ C p/Δt is not included) [same]
 };
 
+// Both sides of the adjointness of the pressure forces and the volume balance (theory.md eqs. 8.1–8.2)
+// for one nodal pressure and one pair of nodal velocity fields.
+struct PressureWork {
+	Real forces  = 0; // Σ_I g^s_I·u^s_I + g^w_I·u^w_I, g = B p [W]
+	Real balance = 0; // Σ_J p_J (Bᵀv)_J from the assembled balance [W]
+	Real scale   = 0; // Σ_I |g^s_I||u^s_I| + |g^w_I||u^w_I|: the size the two are compared at [W]
+};
+
 // The grid-node system of eq. 8.7 and its scratch, reused from step to step.
 struct PressureSystem {
 	// One row of K in stencil form: of the offsets (−2..2)³ between two nodes that share a point, the
@@ -170,6 +178,18 @@ namespace stages {
 	ProjectionForms projectionForms(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
 	                                const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
 	                                Real waterMassTolerance, const std::vector<Real>& freePressures, PressureSystem& system);
+
+	// The adjointness of eqs. 8.1 and 8.2, a check (tests): for the nodal pressure `pressure` (per grid
+	// node) and the nodal velocities in fields.solidVelocityNew and waterVelocityNew, the work of the
+	// pressure forces g = B p (eq. 8.1) on the velocities they act on (u^s = v^s where the skeleton has
+	// mass, else v^w; u^w = v^w where the water has mass, else v^s) and Σ_J p_J (Bᵀv)_J from the volume
+	// balance as assemblePressureSystem builds it (eq. 8.2, storage left out). Equal to round-off when
+	// the forces and the balance are each other's transpose, whatever p and v. The drained faces' boundary
+	// terms (eq. 2.2) are not part of B and are not included. Overwrites `system`'s rows and forces.
+	template <class Kernel>
+	PressureWork pressureWorkAndBalance(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                                    const WaterParameters& water, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
+	                                    Real solidMassTolerance, Real waterMassTolerance, const std::vector<Real>& pressure, PressureSystem& system);
 
 	// Velocity increments of one node for pressure forces g^s, g^w (eq. 8.8): the nodal 2×2 system
 	// [ms + QΔt, −QΔt; −QΔt, mw + QΔt] (δs, δw) = Δt (g^s, g^w), in closed form.

@@ -418,6 +418,40 @@ std::vector<ProjectionForms> TwoPhaseSolver::projectionFormsWith(Real dt, const 
 	return forms;
 }
 
+std::vector<PressureWork> TwoPhaseSolver::pressureWorkCheck(Real dt, int samples, unsigned seed)
+{
+	if (waters_.empty() || settings_.scheme != TimeScheme::SemiImplicit) throw std::logic_error("pressureWorkCheck: needs water points and the semi-implicit scheme");
+	return settings_.shapeFunction == ShapeFunction::Linear ? pressureWorkCheckWith<LinearKernel>(dt, samples, seed) : pressureWorkCheckWith<GimpKernel>(dt, samples, seed);
+}
+
+template <class Kernel> std::vector<PressureWork> TwoPhaseSolver::pressureWorkCheckWith(Real dt, int samples, unsigned seed)
+{
+	using namespace stages;
+	const PlateMotion plate = plate_; // the predictor moves the plate; this check must not
+	resetGridStage(true);
+	mapPointsToGrid<Kernel>(true);
+	integrateMomentum(dt, true, true);
+	classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, settings_.gravity, water_.density, pressureSystem_);
+	plate_ = plate;
+	auto random = [&seed] { // a fixed linear congruential sequence in [−1, 1]
+		seed = 1664525u * seed + 1013904223u;
+		return 2.0 * seed / 4294967296.0 - 1;
+	};
+	std::vector<PressureWork> works;
+	GridFields                drawn = fields_;
+	for (int k = 0; k < samples; ++k) {
+		std::vector<Real> pressure(grid_.nodeCount(), 0);
+		for (std::size_t I : pressureSystem_.node) pressure[I] = 1e3 * random();
+		for (std::size_t I = 0; I < grid_.nodeCount(); ++I) {
+			drawn.solidVelocityNew[I] = 1e-2 * Vec3(random(), random(), random());
+			drawn.waterVelocityNew[I] = 1e-2 * Vec3(random(), random(), random());
+		}
+		works.push_back(pressureWorkAndBalance<Kernel>(grid_, drawn, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt,
+		                                               solidMassTolerance_, waterMassTolerance_, pressure, pressureSystem_));
+	}
+	return works;
+}
+
 Real TwoPhaseSolver::drainageRelaxationTime() const
 {
 	if (waters_.empty()) return inf;

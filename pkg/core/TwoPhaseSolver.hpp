@@ -141,9 +141,15 @@ public:
 	// compact and the exact quadratic forms for each of the given free nodal pressure fields (each
 	// sized to the free nodes; `fields(freeNodes)` builds them from the free nodes' positions).
 	std::vector<ProjectionForms> projectionForms(Real dt, const std::function<std::vector<std::vector<Real>>(const std::vector<Vec3>&)>& fields);
+	// A check of the adjointness of the pressure forces and the volume balance (theory.md eqs. 8.1–8.2,
+	// tests): maps the points as a step of size dt would (nothing moves), then for `samples` draws of a
+	// pseudo-random nodal pressure on the pressure nodes (±1 kPa) and pseudo-random nodal velocities of
+	// both phases (±1 cm/s, every node) returns both sides of Σ g·u = pᵀBᵀv (stages::pressureWorkAndBalance).
+	std::vector<PressureWork> pressureWorkCheck(Real dt, int samples, unsigned seed);
 
 private:
 	template <class Kernel> std::vector<ProjectionForms> projectionFormsWith(Real dt, const std::function<std::vector<std::vector<Real>>(const std::vector<Vec3>&)>& fields);
+	template <class Kernel> std::vector<PressureWork> pressureWorkCheckWith(Real dt, int samples, unsigned seed);
 	template <class Kernel> void stepWith(Real dt);
 	// The stencil weights of every point at its current position, computed once and read by every
 	// stage until the points move (theory.md §4, stencil weights); cleared before they move and when

@@ -404,6 +404,53 @@ TEST(ProjectionStability, TheCompactOperatorBoundsTheExactOneWhereThePointsReach
 	EXPECT_LT(worstFormRatio(ShapeFunction::UGimp, 0, 0, 1.0, 0.9), 1);
 }
 
+// The pressure's forces and the volume balance are each other's transpose (theory.md eqs. 8.1–8.2):
+// Σ_I g_I(p)·u_I = pᵀ Bᵀ v for every nodal pressure p and every pair of nodal velocity fields, the
+// balance as the assembly builds it. This is what makes the projection's pressure do no work but the
+// stabilisation's −Δt pᵀ(L − A)p (its energy identity); a term added to the forces and not to the
+// balance (or the reverse) breaks it for most p and v. Checked where the operators have their special
+// cases: a phreatic surface sloping at 15° inside the soil (partly wet nodes of eq. 8.5c, dry solid
+// points of eq. 8.1c, the skeleton's share θ of eq. 8.1 between 0 and 1), a free water layer over the
+// soil (nodes of one phase), water points jittered off the lattice by up to a fifth of their spacing,
+// both kernels; 5 draws each of p (±1 kPa) and v (±1 cm/s) at every node.
+TEST(ProjectionAdjointness, PressureForcesDoTheWorkOfTheBalanceTransposed)
+{
+	const double g = g0, L = 0.2, h = 0.025, pi = std::acos(-1.0);
+	for (ShapeFunction kernel : { ShapeFunction::UGimp, ShapeFunction::Linear })
+		for (bool pool : { false, true }) {
+			SoilParameters  soil;
+			WaterParameters water;
+			soil.intrinsicPermeability = 1e-3 * water.viscosity / (water.density * g);
+			const double    soilTop = pool ? 0.15 : 0.2;
+			const auto      table   = [&](const Vec3& x) { return pool ? 0.25 : 0.12 + (x.x() - L / 2) * std::tan(15 * pi / 180); };
+			SolidPointSet   solid   = fixtures::solidLattice(fixtures::lattice(Vec3::Zero(), Vec3(L, h, soilTop), h, 2), soil.porosity, soil.density);
+			WaterPointSet   fluid   = fixtures::waterLattice(
+                                fixtures::latticeWhere(fixtures::lattice(Vec3::Zero(), Vec3(L, h, 0.25), h, 2), [&](const Vec3& x) { return x.z() < table(x) && (pool || x.z() < soilTop); }),
+                                soil.porosity, water.density);
+			unsigned seed = 2024;
+			for (std::size_t p = 0; p < fluid.size(); ++p) {
+				if (fluid.position[p].z() > soilTop) fluid.porosity[p] = 1, fluid.volume[p] = fluid.mass[p] / water.density; // free water
+				for (int d : { 0, 2 }) {
+					seed = 1664525u * seed + 1013904223u;
+					fluid.position[p][d] += 0.2 * (h / 2) * (2.0 * seed / 4294967296.0 - 1);
+				}
+			}
+			Domain d = fixtures::columnDomain(Vec3(L, h, 0.3), h);
+			d.boundaries.walls[static_cast<int>(Face::XMin)] = d.boundaries.walls[static_cast<int>(Face::XMax)] = { SolidWall::Fixed, WaterWall::Impermeable };
+			d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Drained, 0.0 };
+			SolverSettings s;
+			s.gravity       = Vec3(0, 0, -g);
+			s.shapeFunction = kernel;
+			TwoPhaseSolver solver(d, s);
+			solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+			const double dt = 0.5 * solver.timeStepLimits().critical;
+			for (const PressureWork& w : solver.pressureWorkCheck(dt, 5, 7)) {
+				EXPECT_GT(w.scale, 0);
+				EXPECT_NEAR(w.forces, w.balance, 1e-12 * w.scale) << (kernel == ShapeFunction::Linear ? "linear" : "uGIMP") << (pool ? ", free water layer" : ", sloping table");
+			}
+		}
+}
+
 namespace {
 
 // Mean over the element ζ ∈ [0, d] of p(ζ, t) for 1D diffusion (c) in a half-space drained at ζ = 0
