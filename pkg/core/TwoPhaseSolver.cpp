@@ -393,18 +393,25 @@ std::vector<ProjectionForms> TwoPhaseSolver::projectionForms(Real dt, const std:
 	return settings_.shapeFunction == ShapeFunction::Linear ? projectionFormsWith<LinearKernel>(dt, fields) : projectionFormsWith<GimpKernel>(dt, fields);
 }
 
+// The checks' common start: a step of size dt up to the classified pressure nodes (Steps 0–6, §8.5),
+// with no point moved and the rigid plate where it was.
+template <class Kernel> void TwoPhaseSolver::predictForCheck(Real dt)
+{
+	const PlateMotion plate = plate_; // the predictor moves the plate; a check must not
+	resetGridStage(true);
+	mapPointsToGrid<Kernel>(true);
+	integrateMomentum(dt, true, true);
+	stages::classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, settings_.gravity, water_.density, pressureSystem_);
+	plate_ = plate;
+}
+
 template <class Kernel>
 std::vector<ProjectionForms> TwoPhaseSolver::projectionFormsWith(Real dt, const std::function<std::vector<std::vector<Real>>(const std::vector<Vec3>&)>& fields)
 {
 	using namespace stages;
-	const PlateMotion plate = plate_; // the predictor moves the plate; this check must not
-	resetGridStage(true);
-	mapPointsToGrid<Kernel>(true);
-	integrateMomentum(dt, true, true);
-	classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, settings_.gravity, water_.density, pressureSystem_);
+	predictForCheck<Kernel>(dt);
 	assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, pressureSystem_);
 	buildPressureMatrix(grid_, pressureSystem_);
-	plate_ = plate;
 	std::vector<Vec3> freeNodes(static_cast<std::size_t>(pressureSystem_.matrix.rows()));
 	for (std::size_t r = 0; r < pressureSystem_.node.size(); ++r) {
 		if (pressureSystem_.fixed[r]) continue;
@@ -427,12 +434,7 @@ std::vector<PressureWork> TwoPhaseSolver::pressureWorkCheck(Real dt, int samples
 template <class Kernel> std::vector<PressureWork> TwoPhaseSolver::pressureWorkCheckWith(Real dt, int samples, unsigned seed)
 {
 	using namespace stages;
-	const PlateMotion plate = plate_; // the predictor moves the plate; this check must not
-	resetGridStage(true);
-	mapPointsToGrid<Kernel>(true);
-	integrateMomentum(dt, true, true);
-	classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, settings_.gravity, water_.density, pressureSystem_);
-	plate_ = plate;
+	predictForCheck<Kernel>(dt);
 	auto random = [&seed] { // a fixed linear congruential sequence in [−1, 1]
 		seed = 1664525u * seed + 1013904223u;
 		return 2.0 * seed / 4294967296.0 - 1;

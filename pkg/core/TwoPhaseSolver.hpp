@@ -150,6 +150,7 @@ public:
 private:
 	template <class Kernel> std::vector<ProjectionForms> projectionFormsWith(Real dt, const std::function<std::vector<std::vector<Real>>(const std::vector<Vec3>&)>& fields);
 	template <class Kernel> std::vector<PressureWork> pressureWorkCheckWith(Real dt, int samples, unsigned seed);
+	template <class Kernel> void predictForCheck(Real dt);
 	template <class Kernel> void stepWith(Real dt);
 	// The stencil weights of every point at its current position, computed once and read by every
 	// stage until the points move (theory.md §4, stencil weights); cleared before they move and when
