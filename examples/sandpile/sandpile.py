@@ -29,7 +29,8 @@ Writes to DIR (default examples/sandpile/out[-quick]):
                                   (runout_m), deposit profile, mobilised volume, the first mobilised
                                   zone at the onset, sliding surface,
                                   limit-equilibrium onset heads (lem_onset_head_m; lem_deep_onset_head_m
-                                  for slides ≥ 3 cells deep), water balance
+                                  for slides ≥ 3 cells deep; lem_deep_peak_onset_head_m for the same at
+                                  the sand's peak strength, without Davis), water balance
                                   (injected_kg, removed_kg, relative_residual), run time
 The water mass balance (initial + injected = stored + removed) is checked at every record; the run
 stops with an error if it fails to close to 1e-9. If the solver stops the run as unstable (a point
@@ -293,10 +294,12 @@ while O.time < DURATION - 1e-12:
         circle = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing)
         try:
             deep = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing, min_depth=DEEP_SLIDE_CELLS * CELL)
+            # the same at the model's peak strength: the bound the skeleton can hold before its band softens
+            deep_peak = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing, min_depth=DEEP_SLIDE_CELLS * CELL, davis=False)
         except ValueError:  # no circle that deep fits the pile: no such mechanism
-            deep = None
+            deep = deep_peak = None
         row["lem_factor_of_safety"] = circle.factor
-        lem_records.append((O.time, row["head_m"], circle, deep))
+        lem_records.append((O.time, row["head_m"], circle, deep, deep_peak))
     rows.append(row)
     record_positions.append(solid.pos.astype(np.float32))
     if settled is None and O.time >= SCENE.settle_time - 1e-9:
@@ -345,7 +348,7 @@ if len(surface_x):
 
 # --- limit equilibrium: the head at which Bishop's factor of safety first falls below 1 -----------
 def lem_crossing(which):
-    """Where the factor of the circles `which` (2: shallowest, 3: deep) first falls below 1, linear
+    """Where the factor of the circles `which` (2: shallowest, 3: deep, 4: deep at the peak strength) first falls below 1, linear
     between two evaluations; None if it never does."""
     for r0, r1 in zip(lem_records, lem_records[1:]):
         (t0, h0), (t1, h1), c0, c1 = r0[:2], r1[:2], r0[which], r1[which]
@@ -355,14 +358,16 @@ def lem_crossing(which):
     return None
 
 
-lem_onset, lem_deep_onset = lem_crossing(2), lem_crossing(3)
+lem_onset, lem_deep_onset, lem_deep_peak_onset = lem_crossing(2), lem_crossing(3), lem_crossing(4)
 lem_summary = {"method": "Bishop simplified, critical circle (yade_mpm.slope_stability)",
                "strength": "c = 0, Davis (1968) for φ = %.0f°, ψ = %.0f°" % (math.degrees(SCENE.friction_angle), math.degrees(SCENE.dilatancy_angle)),
                "times_s": [r[0] for r in lem_records], "heads_m": [r[1] for r in lem_records],
                "factors": [r[2].factor for r in lem_records], "onset": lem_onset,
                "lem_onset_head_m": None if lem_onset is None else lem_onset["head_m"],
                "deep_min_depth_m": DEEP_SLIDE_CELLS * CELL, "deep_factors": [None if r[3] is None else r[3].factor for r in lem_records], "deep_onset": lem_deep_onset,
-               "lem_deep_onset_head_m": None if lem_deep_onset is None else lem_deep_onset["head_m"]}
+               "lem_deep_onset_head_m": None if lem_deep_onset is None else lem_deep_onset["head_m"],
+               "deep_peak_factors": [None if r[4] is None else r[4].factor for r in lem_records], "deep_peak_onset": lem_deep_peak_onset,
+               "lem_deep_peak_onset_head_m": None if lem_deep_peak_onset is None else lem_deep_peak_onset["head_m"]}
 
 # --- kinematic onset, run-out, deposit ---------------------------------------------------------------
 # Under a rising head the onset is where the slope face's displacement grows ten times faster with
@@ -420,6 +425,7 @@ summary = {
     "first_mobilised_zone": first_zone,
     "lem_onset_head_m": lem_summary["lem_onset_head_m"],
     "lem_deep_onset_head_m": lem_summary["lem_deep_onset_head_m"],
+    "lem_deep_peak_onset_head_m": lem_summary["lem_deep_peak_onset_head_m"],
     "runout_m": runout,
     "mobilised_volume_m3": mobilised,
     "mobilised_fraction": mobilised_fraction,
@@ -515,6 +521,7 @@ a3.set_ylabel("displacement [mm]")
 a3.legend(fontsize=7)
 a4.plot([r[0] for r in lem_records], [r[2].factor for r in lem_records], "o-", label="Bishop, Davis strength, run's own p")
 a4.plot([r[0] for r in lem_records], [math.nan if r[3] is None else r[3].factor for r in lem_records], "s--", label="the same, slides ≥ %d cells deep" % DEEP_SLIDE_CELLS)
+a4.plot([r[0] for r in lem_records], [math.nan if r[4] is None else r[4].factor for r in lem_records], "^:", label="slides ≥ %d cells deep, peak strength (no Davis)" % DEEP_SLIDE_CELLS)
 a4.axhline(1, color="k", lw=0.8)
 a4.set_ylabel("LEM factor of safety [-]")
 a4.set_xlabel("t [s]")
@@ -525,5 +532,5 @@ if failure:
 fig.tight_layout()
 fig.savefig(os.path.join(OUT, "time_series.png"), dpi=110)
 print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "stopped_unstable", "failure", "sliding_surface", "water_mass_balance", "stable_before_rise")}, indent=2))
-print(json.dumps({k: lem_summary[k] for k in ("lem_onset_head_m", "factors", "lem_deep_onset_head_m", "deep_factors")}))
+print(json.dumps({k: lem_summary[k] for k in ("lem_onset_head_m", "factors", "lem_deep_onset_head_m", "deep_factors", "lem_deep_peak_onset_head_m", "deep_peak_factors")}))
 print(json.dumps({k: summary[k] for k in ("onset", "kinetic_onset", "runout_m", "mobilised_fraction")}))

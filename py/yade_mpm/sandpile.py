@@ -149,17 +149,20 @@ def pile_points(scene, cell_size, points_per_cell=2):
     return np.stack([X[inside], Y[inside], Z[inside]], axis=1), spacing
 
 
-def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing, min_depth=None):
+def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing, min_depth=None, davis=True):
     """Bishop's critical circle of the pile's downstream slope on the run's current state
     (yade_mpm.slope_stability): weights from both phases' point masses, pore pressures from the
     water points, averaged over the flume's width; the sand's peak strength reduced for its
-    non-associated flow by Davis (φ = 36°, ψ = 6° → φ* = 31.9°); slip circles no deeper than the
+    non-associated flow by Davis (φ = 36°, ψ = 6° → φ* = 31.9°), or with davis=False the peak itself
+    (the upper bound the model's skeleton can mobilise before it softens); slip circles no deeper than the
     flume base and at least min_depth deep [m] (default one cell: a thinner slide is below what the
     MPM resolves); with a crest lid, only slides that break through the ground downstream of it (the
     lid's reaction, which holds the crest down against the excess pressure, is not known to the
     method). Returns the slope_stability.CriticalCircle (its .factor is the factor of safety)."""
     from . import slope_stability
-    strength = slope_stability.Strength(cohesion=0.0, friction_angle=scene.friction_angle, dilatancy_angle=scene.dilatancy_angle).davis()
+    strength = slope_stability.Strength(cohesion=0.0, friction_angle=scene.friction_angle, dilatancy_angle=scene.dilatancy_angle)
+    if davis:
+        strength = strength.davis()
     solid_mass, water_mass = np.asarray(solid.mass), np.asarray(fluid.mass)
     if scene.still_water_level is not None:
         # submerged (eq. 1.9): buoyant grains, weightless water and excess pore pressures — Bishop's
