@@ -47,17 +47,16 @@ namespace {
 	{
 		static_assert(pairLanes<S> >= S && sizeof(PairLane<S>) == pairLanes<S> * sizeof(Real), "a run of S slots fits in one lane vector");
 		using Lane = PairLane<S>;
-		Real xv[S][S], xg[S][S], yv[S][S], yg[S][S], zv[S][S], zg[S][S];
-		Real xvPad[S][pairLanes<S>] = {}, xgPad[S][pairLanes<S>] = {};
+		Real xv[S][pairLanes<S>] = {}, xg[S][pairLanes<S>] = {}; // padded with zeros to a lane vector per row
+		Real yv[S][S], yg[S][S], zv[S][S], zg[S][S];
 		for (int i = 0; i < S; ++i)
 			for (int j = 0; j < S; ++j) {
 				xv[i][j] = w[0].value[i] * w[0].value[j], xg[i][j] = w[0].gradient[i] * w[0].gradient[j];
 				yv[i][j] = w[1].value[i] * w[1].value[j], yg[i][j] = w[1].gradient[i] * w[1].gradient[j];
 				zv[i][j] = w[2].value[i] * w[2].value[j], zg[i][j] = w[2].gradient[i] * w[2].gradient[j];
-				xvPad[i][j] = xv[i][j], xgPad[i][j] = xg[i][j];
 			}
-		Lane xvLane[S], xgLane[S]; // xv, xg padded with zeros
-		for (int i = 0; i < S; ++i) std::memcpy(&xvLane[i], xvPad[i], sizeof(Lane)), std::memcpy(&xgLane[i], xgPad[i], sizeof(Lane));
+		Lane xvLane[S], xgLane[S];
+		for (int i = 0; i < S; ++i) std::memcpy(&xvLane[i], xv[i], sizeof(Lane)), std::memcpy(&xgLane[i], xg[i], sizeof(Lane));
 		// slot[0..S) += xv A + xg B in one vector operation (the same products and sums per slot as
 		// the scalar loop: results equal bit for bit)
 		auto addRun = [&](Real* slot, int a, Real A, Real B) {
