@@ -408,11 +408,13 @@ TEST(ProjectionStability, TheCompactOperatorBoundsTheExactOneWhereThePointsReach
 // Σ_I g_I(p)·u_I = pᵀ Bᵀ v for every nodal pressure p and every pair of nodal velocity fields, the
 // balance as the assembly builds it. This is what makes the projection's pressure do no work but the
 // stabilisation's −Δt pᵀ(L − A)p (its energy identity); a term added to the forces and not to the
-// balance (or the reverse) breaks it for most p and v. Checked where the operators have their special
-// cases: a phreatic surface sloping at 15° inside the soil (partly wet nodes of eq. 8.5c, dry solid
-// points of eq. 8.1c, the skeleton's share θ of eq. 8.1 between 0 and 1), a free water layer over the
-// soil (nodes of one phase), water points jittered off the lattice by up to a fifth of their spacing,
-// both kernels; 5 draws each of p (±1 kPa) and v (±1 cm/s) at every node.
+// balance (or the reverse) breaks it for most p and v. Checked where B has its special cases, and the
+// test asserts that each scene reaches them: a phreatic surface sloping at 15° inside the soil (nodes
+// the water fills in part, among them some below half, whose solid points are dry: eq. 8.1c's cut), a
+// free water layer over the soil (the skeleton's share θ of eq. 8.1 strictly between 0 and 1 at its
+// surface, and water-only nodes above), water points jittered off the lattice by up to a fifth of their
+// spacing, both kernels; 5 draws each of p (±1 kPa) and v (±1 cm/s) at every node. (The mobility of
+// eq. 8.5, eq. 8.5c included, enters L only, not B: it is not exercised here.)
 TEST(ProjectionAdjointness, PressureForcesDoTheWorkOfTheBalanceTransposed)
 {
 	const double g = g0, L = 0.2, h = 0.025, pi = std::acos(-1.0);
@@ -444,10 +446,29 @@ TEST(ProjectionAdjointness, PressureForcesDoTheWorkOfTheBalanceTransposed)
 			TwoPhaseSolver solver(d, s);
 			solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
 			const double dt = 0.5 * solver.timeStepLimits().critical;
+			const char* scene = pool ? "free water layer" : "sloping table";
 			for (const PressureWork& w : solver.pressureWorkCheck(dt, 5, 7)) {
 				EXPECT_GT(w.scale, 0);
-				EXPECT_NEAR(w.forces, w.balance, 1e-12 * w.scale) << (kernel == ShapeFunction::Linear ? "linear" : "uGIMP") << (pool ? ", free water layer" : ", sloping table");
+				EXPECT_NEAR(w.forces, w.balance, 1e-12 * w.scale) << (kernel == ShapeFunction::Linear ? "linear, " : "uGIMP, ") << scene;
 			}
+			// the special cases are there (the check's last assembly, the same points)
+			const PressureSystem& S = solver.pressureSystem();
+			int partlyWet = 0, mostlyDry = 0, shared = 0, waterOnly = 0;
+			for (std::size_t I = 0; I < S.skeletonWetting.size(); ++I) {
+				const double wet = S.skeletonWetting[I], theta = S.skeletonShare[I];
+				partlyWet += wet > 0 && wet < 1, mostlyDry += wet > 0 && wet < 0.5;
+				shared += theta > 0 && theta < 1;
+				waterOnly += theta == 0 && solver.fields().water[I].mass > 0;
+			}
+			if (pool) {
+				EXPECT_GT(shared, 0) << scene;
+				EXPECT_GT(waterOnly, 0) << scene;
+			} else {
+				EXPECT_GT(partlyWet, 0) << scene;
+				EXPECT_GT(mostlyDry, 0) << scene;
+			}
+			std::printf("%s, %s: %d nodes partly wet (%d below half), %d with 0 < θ < 1, %d water only\n", kernel == ShapeFunction::Linear ? "linear" : "uGIMP", scene,
+			            partlyWet, mostlyDry, shared, waterOnly);
 		}
 }
 

@@ -42,8 +42,10 @@ def test_submerged_pile_stands_at_the_still_level(submerged_run):
     assert lem["deep_min_depth_m"] == pytest.approx(3 * s["cell_size_m"])
     assert lem["deep_factors"][0] > lem["factors"][0]
     # and at the sand's peak strength (no Davis reduction; tan 36° = 0.727 against tan 31.9° = 0.623):
-    # with c = 0 Bishop's F grows with tan φ, so the same search at the peak stands higher at every frame
-    # (measured 1.58 against 1.35 at rest, 1.08 against 0.93 under the raised head of the 60 s lidded run)
+    # with c = 0 Bishop's F grows with tan φ, so the same search at the peak stands higher at every frame.
+    # F is nearly proportional to tan φ (not exactly: tan φ/F also enters each slice's m_α), so at rest
+    # the ratio is close to 0.727/0.623 = 1.17; asserted above 1.1 (in-run: 1.62 against 1.39 at rest,
+    # 1.13 against 0.97 at 41.7 s of the 60 s lidded run)
     assert all(p > d for p, d in zip(lem["deep_peak_factors"], lem["deep_factors"]) if p is not None and d is not None)
     assert lem["deep_peak_factors"][0] > 1.1 * lem["deep_factors"][0]
 
