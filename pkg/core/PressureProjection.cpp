@@ -102,19 +102,105 @@ namespace {
 } // namespace
 
 namespace stages {
-	// The free surface between node planes (theory.md eq. 8.5b): a surface node I is tied to its
+	namespace {
+	// Eq. 8.5b: a plane normal to the axis fills the supports of the nodes across the axis alike (to
+	// this share), and I's filling f = (h − s)²/(2h²) tells s only from this filling on (s ≤ 0.65 h).
+	constexpr Real filledShareTolerance = 1.0 / 16;
+	constexpr Real informativeFilling   = 1.0 / 16;
+
+	// A node-centred cell counts as full from this share of its in-domain volume and as empty below
+	// this one (eq. 8.5d; the points' volumes are shared by overlap, so a full cell holds its volume
+	// to the water's compression and the points' spread).
+	constexpr Real tubeFullShare  = 15.0 / 16;
+	constexpr Real tubeEmptyShare = 1.0 / 16;
+
+	// Eq. 8.5d: the water points' volume in each node's cell [x_I − h/2, x_I + h/2]³, each point's
+	// state volume m/(n ρw) shared by its domain's overlap with the cells (at most two per axis: l_p ≤ h/2).
+	std::vector<Real> waterVolumePerNodeCell(const GridGeometry& grid, const std::vector<WaterPointSet*>& sets, Real waterDensity)
+	{
+		std::vector<Real> dualVolume(grid.nodeCount(), 0);
+		for (const WaterPointSet* set : sets) {
+			const WaterPointSet& P = *set;
+			for (std::size_t p = 0; p < P.size(); ++p) {
+				int  first[3];
+				Real share[3][2];
+				// the water's amount from its mass, m/(n ρw): the rate-form volume drifts (theory.md §8 Open)
+				const Real volume = P.mass[p] / (P.porosity[p] * waterDensity);
+				for (int d = 0; d < 3; ++d) {
+					const Real centre = (P.position[p][d] - grid.origin[d]) / grid.cellSize, half = P.halfLength[p][d] / grid.cellSize;
+					first[d]          = static_cast<int>(std::floor(centre - half + 0.5));
+					const Real split  = first[d] + 0.5; // the face between the two cells
+					share[d][0]       = half > 0 ? std::clamp((split - (centre - half)) / (2 * half), Real(0), Real(1)) : (centre < split ? 1 : 0);
+					share[d][1]       = 1 - share[d][0];
+				}
+				for (int c = 0; c < 2; ++c)
+					for (int b = 0; b < 2; ++b)
+						for (int a = 0; a < 2; ++a) {
+							const Real w = share[0][a] * share[1][b] * share[2][c];
+							if (w > 0) dualVolume[grid.index(grid.wrap(0, first[0] + a), grid.wrap(1, first[1] + b), grid.wrap(2, first[2] + c))] += w * volume;
+						}
+			}
+		}
+		return dualVolume;
+	}
+
+	// Eq. 8.5d: the distance s from surface node I to the water's surface along `axis` (positive
+	// outwards, i.e. away from the partner `cells` nodes towards `side`), from the water points'
+	// volume in the node-centred cells of the tube through I along the axis (waterVolumePerNodeCell).
+	// From the first full cell at or inwards of the partner
+	// (at most two more) to the first empty one outwards of I, the tube's water over its in-domain
+	// cross-section is the wet length from the tube's inner end, which for a plane surface is its
+	// height on the tube's centre line, the line through I, whatever the plane's slope. False where
+	// the tube has no full cell inwards or no empty one within two cells outwards.
+	bool wetLengthBeyond(const GridGeometry& grid, const std::vector<Real>& dualVolume, const std::array<int, 3>& idx, int axis, int side, int cells,
+	                     Real& s)
+	{
+		const Real h    = grid.cellSize;
+		const int  b    = (axis + 1) % 3, c = (axis + 2) % 3;
+		const Real area = grid.inDomainSupport(b, idx[b]) * grid.inDomainSupport(c, idx[c]);
+		if (!(area > 0)) return false;
+		// in-domain length along the axis and water volume of the cell of the node `steps` from I inwards
+		auto cell = [&](int steps, Real& length) {
+			std::array<int, 3> at = idx;
+			at[axis]              = grid.wrap(axis, idx[axis] + steps * side);
+			length                = at[axis] >= 0 && at[axis] < grid.nodes[axis] ? grid.inDomainSupport(axis, at[axis]) : 0;
+			return length > 0 ? dualVolume[grid.index(at[0], at[1], at[2])] : Real(0);
+		};
+		Real length = 0, volume = 0;
+		int  inner  = cells;
+		for (;; ++inner) {
+			volume = cell(inner, length);
+			if (!(length > 0) || inner > cells + 2) return false;
+			if (volume >= tubeFullShare * area * length) break;
+		}
+		// the inner end: the cell's inner face, on the node itself where the node lies on a wall plane
+		const Real toI = inner * h + (length - h / 2);
+		Real       wet = 0;
+		for (int steps = inner; steps >= -2; --steps) {
+			const Real v = cell(steps, length);
+			if (steps < 0 && (!(length > 0) || v <= tubeEmptyShare * area * length)) {
+				s = toI - wet;
+				return true;
+			}
+			wet += v / area;
+		}
+		return false;
+	}
+	} // namespace
+
+	// The free surface between node planes (theory.md eqs. 8.5b, 8.5d): a surface node I is tied to its
 	// free neighbour J inwards, p_I = c p_J with c = −s/(kh − s), s the distance from I to the surface
 	// along the axis (positive outwards) and kh that from J to I (k = 1, or 2 through a tied neighbour),
-	// so that p varies linearly from J to zero at the surface itself
-	// (the ghost value of Gibou et al. 2002, J. Comput. Phys. 176, 205–227; Enright et al. 2003 for free
-	// surfaces), not at the node half a cell outside. s comes from I's filling f, which for a plane
-	// surface normal to the axis and a hat support is f = (h − s)²/(2h²) (s ≥ 0), 1 − (h + s)²/(2h²)
-	// (s < 0). That inversion holds only for such a surface: a node is tied only where the fillings of
-	// its neighbours across the axis equal its own within filledShareTolerance (a flat surface), and
-	// the neighbour outwards (if any) is fuller no more than I; elsewhere it keeps p = 0 at the node.
-	constexpr Real filledShareTolerance = 0.125;
-	void tieSurfaceNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<char>& surface, PressureSystem& system)
+	// so that p varies linearly from J to zero at the surface itself (the ghost value of Gibou et al.
+	// 2002, J. Comput. Phys. 176, 205–227; Enright et al. 2003 for free surfaces), not at the node half
+	// a cell outside. s comes from I's filling where the surface is a plane normal to the axis (eq.
+	// 8.5b) and from the water's wet length along the axis through I elsewhere (eq. 8.5d, wetLengthBeyond),
+	// which places a plane surface at any slope; J is the fullest free neighbour, the neighbour outwards
+	// (if any) may be no fuller than I, and where neither applies I keeps p = 0.
+	void tieSurfaceNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, Real waterDensity,
+	                     const std::vector<char>& surface, PressureSystem& system)
 	{
+		std::vector<Real> dualVolume; // eq. 8.5d's cell volumes, deposited when a surface first needs them
 		const std::size_t active = system.node.size();
 		system.ghostMaster.assign(active, -1);
 		system.ghostFactor.assign(active, 0);
@@ -160,9 +246,11 @@ namespace stages {
 						if (fJ > fullest) fullest = fJ, inner = candidate, axis = d, side = step;
 					}
 				if (inner < 0) continue;
-				bool               flat = true;
 				std::array<int, 3> at;
-				if (neighbour(axis, -side, at) && nodeFilling(grid, fields, at) > f) flat = false;
+				if (neighbour(axis, -side, at) && nodeFilling(grid, fields, at) > f) continue; // not the outside of a surface
+				// a plane normal to the axis (the neighbours across it filled as I): s from I's filling (eq. 8.5b),
+				// unless the filling is too small to tell how far the surface lies (then s ≈ h whatever it is)
+				bool flat = f >= informativeFilling;
 				for (int d = 0; d < 3 && flat; ++d) {
 					if (d == axis) continue;
 					for (int step : { -1, 1 })
@@ -170,10 +258,16 @@ namespace stages {
 						    std::abs(nodeFilling(grid, fields, at) - f) > filledShareTolerance)
 							flat = false;
 				}
-				if (!flat) continue;
-				const Real s = f <= 0.5 ? h * (1 - std::sqrt(2 * std::max<Real>(f, 0))) : -h * (1 - std::sqrt(2 * (1 - std::min<Real>(f, 1))));
-				// the same plane puts the surface at least (1 − √(2(1 − β))) h beyond a free node (filling ≥ β =
-				// freeSurfaceFilling): a master closer to it contradicts the plane
+				Real s = 0;
+				if (flat) s = f <= 0.5 ? h * (1 - std::sqrt(2 * f)) : -h * (1 - std::sqrt(2 * (1 - std::min<Real>(f, 1))));
+				else {
+					// any other surface: s from the water's wet length along the axis (eq. 8.5d)
+					if (dualVolume.empty()) dualVolume = waterVolumePerNodeCell(grid, sets, waterDensity);
+					if (!wetLengthBeyond(grid, dualVolume, idx, axis, side, cells, s)) continue;
+				}
+				// a plane surface normal to the axis lies at least (1 − √(2(1 − β))) h beyond a free node
+				// (filling ≥ β = freeSurfaceFilling, hat support): a master closer to the surface is not
+				// one the tie can extrapolate from (|c| ≤ 2.4)
 				if (!(cells * h - s >= (1 - std::sqrt(2 * (1 - freeSurfaceFilling))) * h)) continue;
 				master[r] = inner;
 				factor[r] = -s / (cells * h - s);
@@ -247,7 +341,7 @@ namespace stages {
 				if (!(full > 0) || fields.water[I].volume < freeSurfaceFilling * full) system.fixed[r] = 1, surface[r] = 1;
 			}
 		}
-		tieSurfaceNodes(grid, fields, surface, system);
+		tieSurfaceNodes(grid, fields, sets, waterDensity, surface, system);
 	}
 
 	template <class Kernel>

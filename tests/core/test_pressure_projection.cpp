@@ -228,4 +228,66 @@ void expectMatrixIsThePairSum(bool periodicX)
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinition) { expectMatrixIsThePairSum(false); }
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionAcrossAPeriodicSeamOfThreeCells) { expectMatrixIsThePairSum(true); }
 
+// Eqs. 8.5b and 8.5d: a surface that slopes across the grid. Free water fills a box below the plane
+// z = z0 + x tan γx + y tan γy (water points on a lattice of m per cell and axis, kept where the centre
+// lies below the plane: a staircase of steps h/m). At rest its pressure is hydrostatic, p = ρw g d, d
+// the depth below the plane — linear, so a surface node tied to a free one along an axis carries
+// p_I = c p_J exactly when the tie puts p's zero where the plane crosses that axis: c = −s/(kh − s),
+// s the distance from I to the plane along the axis (positive outwards), kh from J to I. Checked: s
+// read back from every tie against the plane's, within half a step of the staircase, h/(2m) (the
+// tube's water is the staircase's, whose top lies within half a step of the plane), for ties one
+// and two cells from their master; and the surface is tied along its length (more than 10 nodes).
+// (The filling inversion eq. 8.5b used before, exact only for a plane normal to the axis, tied 0 of
+// these nodes at 30° and put s up to 0.3 h off on the oblique plane: a node more than a cell above
+// the surface has filling ≈ 0, which reads as s ≈ h whatever the distance.)
+void expectTiesPutTheZeroOnASlopingPlane(int perCell, double slopeX, double slopeY)
+{
+	const Real         h = 0.1;
+	const GridGeometry grid = GridGeometry::forDomain(Vec3::Zero(), Vec3(0.8, 0.6, 0.8), h);
+	const Real         tx = std::tan(slopeX), ty = std::tan(slopeY), z0 = 0.263;
+	auto depth = [&](const Vec3& x) { return (z0 + (x.x() - 0.4) * tx + (x.y() - 0.3) * ty) - x.z(); }; // vertical, below the plane
+	const auto l = fixtures::latticeWhere(fixtures::lattice(Vec3::Zero(), Vec3(0.8, 0.6, 0.8), h, perCell), [&](const Vec3& x) { return depth(x) > 0; });
+	WaterParameters water;
+	WaterPointSet   fluid = fixtures::waterLattice(l, 1.0, water.density);
+	GridFields      fields;
+	fields.resize(grid.nodeCount());
+	std::vector<WaterPointSet*> waters { &fluid };
+	ScatterWorkspace            ws;
+	stages::resetGrid(fields);
+	stages::computeNodalPorosity(fields);
+	stages::mapWaterToGrid<GimpKernel>(grid, waters, Vec3::Zero(), fields, ws);
+	BoundaryConditions bcs;
+	for (int f = 0; f < faceCount; ++f) bcs.walls[f].water = WaterWall::Impermeable;
+	PressureSystem system;
+	stages::classifyPressureNodes<GimpKernel>(grid, fields, waters, bcs, Vec3(0, 0, -9.81), water.density, system);
+	int  tied[3] = { 0, 0, 0 };
+	Real worst   = 0;
+	for (std::size_t r = 0; r < system.node.size(); ++r) {
+		if (system.ghostMaster[r] < 0) continue;
+		const auto I = grid.indices(system.node[r]), J = grid.indices(system.node[static_cast<std::size_t>(system.ghostMaster[r])]);
+		int axis = -1, cells = 0;
+		for (int d = 0; d < 3; ++d)
+			if (I[d] != J[d]) axis = d, cells = I[d] - J[d];
+		ASSERT_GE(axis, 0);
+		++tied[axis];
+		const Real c = system.ghostFactor[r], kh = std::abs(cells) * h;
+		const Real s = c * kh / (c - 1); // c = −s/(kh − s)
+		// the plane along the axis from I, outwards (away from J)
+		const Vec3 xI = grid.nodePosition(I[0], I[1], I[2]);
+		Vec3       out = Vec3::Zero();
+		out[axis]      = cells > 0 ? 1 : -1;
+		const Real rate = -(out.x() * tx + out.y() * ty - out.z()); // d(depth)/d(step outwards) is −rate
+		ASSERT_GT(rate, 0) << "a tie must point outwards, towards the dry side";
+		const Real exact = -depth(xI) / rate; // s > 0: I lies outside the water
+		worst            = std::max(worst, std::abs(s - exact));
+		EXPECT_NEAR(s, exact, h / (2 * perCell)) << "node " << I[0] << " " << I[1] << " " << I[2] << " tied along " << axisName(axis);
+	}
+	std::printf("%d per cell, slopes %.0f°, %.0f°: ties along x %d, y %d, z %d; largest |s − s_plane| = %.3f h\n", perCell, slopeX * 180 / std::acos(-1.0),
+	            slopeY * 180 / std::acos(-1.0), tied[0], tied[1], tied[2], worst / h);
+	EXPECT_GT(tied[2], 10);
+}
+
+TEST(SurfaceTies, PutThePressuresZeroOnATableSloping30DegreesAcrossTheGrid) { expectTiesPutTheZeroOnASlopingPlane(2, std::acos(-1.0) / 6, 0); }
+TEST(SurfaceTies, PutThePressuresZeroOnAnObliqueTableWithThreePointsPerCell) { expectTiesPutTheZeroOnASlopingPlane(3, 0.35, 0.2); }
+
 } // namespace
