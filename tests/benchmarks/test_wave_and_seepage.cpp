@@ -798,7 +798,7 @@ namespace {
 // from 24 s at 2.5 cm (−1.5% over 24–38 s), then the water points' volume drift lowers its inflow (−4 to
 // −7% by 50 s; theory.md §8 Open). Before eq. 8.5d the sloping surface's nodes held p = 0 up to 0.29 h
 // inside the water, the 0.4 m dam stored only 3% more than Dupuit's and read −4.9%/−5.1% (h = 5 cm,
-// 10–30 s) and −2.8%/−1.2% (2.5 cm, 10–13 s).
+// 10–30 s) and −2.8%/−1.2% (2.5 cm, 10–13 s), and this test's 0.2 m dam −6.8%/−8.1% and −2.5%/−2.1%.
 // The dam above at cell size h (the test and the study below).
 struct CharnyDam {
 	static constexpr double g = 9.81, soilHeight = 0.35, H1 = 0.3, H2 = 0.1, k = 0.01;
