@@ -879,7 +879,8 @@ TEST(Charny, RectangularDamCarriesCharnysDischargeInAndOut)
 // Per window also: where the lowest and highest V/(m/(n ρw)) sit, the phreatic surface (the top of the
 // highest water point's domain per cell column) and the water's discharge per cell row through the
 // first and the last cell column (Σ m v_x/(ρw h²) of the points there, ×1e-3 m² s⁻¹), which show where
-// a face's supply or outflow changes. MPM_CHARNY_H [m] and MPM_CHARNY_END [s] run one cell size instead.
+// a face's supply or outflow changes. MPM_CHARNY_H [m] and MPM_CHARNY_END [s] run one cell size instead,
+// MPM_CHARNY_L [m] a dam of another length (default 0.4 m; the test's is 0.2 m).
 TEST(Charny, DISABLED_StudyHistory)
 {
 	std::vector<std::pair<double, double>> runs { { 0.025, 24.0 }, { 0.0125, 16.0 } };
