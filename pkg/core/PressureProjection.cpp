@@ -103,11 +103,6 @@ namespace {
 
 namespace stages {
 	namespace {
-	// Eq. 8.5b: a plane normal to the axis fills the supports of the nodes across the axis alike (to
-	// this share), and I's filling f = (h − s)²/(2h²) tells s only from this filling on (s ≤ 0.65 h).
-	constexpr Real filledShareTolerance = 1.0 / 16;
-	constexpr Real informativeFilling   = 1.0 / 16;
-
 	// A node-centred cell counts as full from this share of its in-domain volume and as empty below
 	// this one (eq. 8.5d; the points' volumes are shared by overlap, so a full cell holds its volume
 	// to the water's compression and the points' spread).
@@ -193,10 +188,10 @@ namespace stages {
 	// along the axis (positive outwards) and kh that from J to I (k = 1, or 2 through a tied neighbour),
 	// so that p varies linearly from J to zero at the surface itself (the ghost value of Gibou et al.
 	// 2002, J. Comput. Phys. 176, 205–227; Enright et al. 2003 for free surfaces), not at the node half
-	// a cell outside. s comes from I's filling where the surface is a plane normal to the axis (eq.
-	// 8.5b) and from the water's wet length along the axis through I elsewhere (eq. 8.5d, wetLengthBeyond),
+	// a cell outside. s is the water's wet length along the axis through I (eq. 8.5d, wetLengthBeyond),
 	// which places a plane surface at any slope; J is the fullest free neighbour, the neighbour outwards
-	// (if any) may be no fuller than I, and where neither applies I keeps p = 0.
+	// (if any) may be no fuller than I, and where the tube through I has no full cell inwards or no
+	// empty one outwards I keeps p = 0.
 	void tieSurfaceNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, Real waterDensity,
 	                     const std::vector<char>& surface, PressureSystem& system)
 	{
@@ -248,23 +243,10 @@ namespace stages {
 				if (inner < 0) continue;
 				std::array<int, 3> at;
 				if (neighbour(axis, -side, at) && nodeFilling(grid, fields, at) > f) continue; // not the outside of a surface
-				// a plane normal to the axis (the neighbours across it filled as I): s from I's filling (eq. 8.5b),
-				// unless the filling is too small to tell how far the surface lies (then s ≈ h whatever it is)
-				bool flat = f >= informativeFilling;
-				for (int d = 0; d < 3 && flat; ++d) {
-					if (d == axis) continue;
-					for (int step : { -1, 1 })
-						if (neighbour(d, step, at) && grid.inDomainSupportVolume(at[0], at[1], at[2]) > 0 &&
-						    std::abs(nodeFilling(grid, fields, at) - f) > filledShareTolerance)
-							flat = false;
-				}
+				// s from the water's wet length along the axis (eq. 8.5d), at any slope
+				if (dualVolume.empty()) dualVolume = waterVolumePerNodeCell(grid, sets, waterDensity);
 				Real s = 0;
-				if (flat) s = f <= 0.5 ? h * (1 - std::sqrt(2 * f)) : -h * (1 - std::sqrt(2 * (1 - std::min<Real>(f, 1))));
-				else {
-					// any other surface: s from the water's wet length along the axis (eq. 8.5d)
-					if (dualVolume.empty()) dualVolume = waterVolumePerNodeCell(grid, sets, waterDensity);
-					if (!wetLengthBeyond(grid, dualVolume, idx, axis, side, cells, s)) continue;
-				}
+				if (!wetLengthBeyond(grid, dualVolume, idx, axis, side, cells, s)) continue;
 				// a plane surface normal to the axis lies at least (1 − √(2(1 − β))) h beyond a free node
 				// (filling ≥ β = freeSurfaceFilling, hat support): a master closer to the surface is not
 				// one the tie can extrapolate from (|c| ≤ 2.4)
