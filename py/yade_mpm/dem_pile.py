@@ -65,9 +65,12 @@ class PileSample:
         return np.array([O.bodies[int(i)].state.mass for i in self.grain_ids])
 
 
-def _engines(gravity, damping):
-    return [w.ForceResetter(), w.InsertionSortCollider([w.Bo1_Sphere_Aabb(), w.Bo1_Box_Aabb()]), contact_loop(0.0),
-            w.FlowEngine(dead=True, label="flow"), w.NewtonIntegrator(damping=damping, gravity=gravity, label="newton")]
+def _engines(gravity, damping, threads):
+    engines = [w.ForceResetter(), w.InsertionSortCollider([w.Bo1_Sphere_Aabb(), w.Bo1_Box_Aabb()]), contact_loop(0.0),
+               w.FlowEngine(dead=True, label="flow"), w.NewtonIntegrator(damping=damping, gravity=gravity, label="newton")]
+    for engine in engines:
+        engine.ompThreads = threads
+    return engines
 
 
 def _settle(max_steps, grain_ids, unbalanced=0.01, speed=1e-4):
@@ -85,7 +88,8 @@ def _settle(max_steps, grain_ids, unbalanced=0.01, speed=1e-4):
 
 
 def build(scene, gravity, grain_radius=4e-3, radius_spread=RADIUS_SPREAD, slice_width=0.03, friction_angle=math.radians(30), rolling_resistance=0.05,
-          young=2e6, contact_poisson=0.5, wall_friction_angle=0.0, lid_friction_angle=None, lid_pressure=None, grain_lid=False, seed=1, max_steps=200000):
+          young=2e6, contact_poisson=0.5, wall_friction_angle=0.0, lid_friction_angle=None, lid_pressure=None, grain_lid=False, seed=1, max_steps=200000,
+          threads=-1):
     """Reset the scene and build the pile of `scene` (a yade_mpm.sandpile.SandPileScene with still
     water: PFV models a fully saturated pile) in a slice `slice_width` [m] wide: spheres of mean
     `grain_radius` [m] (± `radius_spread`, relative) rained into the box between the inflow wall
@@ -101,7 +105,10 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=RADIUS_SPREAD, slice_
     rear, inflow, outflow; default smooth), `lid_friction_angle` [rad] the lid's (default the
     grains'); `grain_lid`: also freeze the crest's grains within two radii of the lid (a lid of
     grains: a flat wall leaves a more open grain layer along it, a channel the seepage follows);
-    `gravity` the scene's gravity vector [m s⁻²] (z down). Returns a PileSample."""
+    `gravity` the scene's gravity vector [m s⁻²] (z down). `threads`: the DEM engines' ompThreads, −1
+    (default) YADE's thread count, where the contact forces are summed in an order that changes from
+    run to run, so the settled packing is another sample each run; 1 repeats the pile and every run on
+    it to the last digit. Returns a PileSample."""
     from yade import pack, utils
     scene.validate()
     _require("scene.still_water_level", scene.still_water_level, scene.still_water_level is not None,
@@ -116,6 +123,7 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=RADIUS_SPREAD, slice_
     _require("wall_friction_angle", wall_friction_angle, 0 <= wall_friction_angle < math.pi / 2, "[0, π/2) rad")
     _require("lid_friction_angle", lid_friction_angle, lid_friction_angle is None or 0 <= lid_friction_angle < math.pi / 2, "None or [0, π/2) rad")
     _require("lid_pressure", lid_pressure, lid_pressure is None or lid_pressure > 0, "None or (0, inf) Pa")
+    _require("threads", threads, threads == -1 or (isinstance(threads, int) and threads >= 1), "-1 (YADE's thread count) or an integer ≥ 1")
     clock = time.time()
     O.reset()
     g = float(np.linalg.norm(gravity))
@@ -137,7 +145,7 @@ def build(scene, gravity, grain_radius=4e-3, radius_spread=RADIUS_SPREAD, slice_
     cloud = pack.SpherePack()
     cloud.makeCloud(Vector3(0, 0, 0), Vector3(toe, slice_width, top), grain_radius, radius_spread, count, False, 0.95, seed=seed)
     O.bodies.append([utils.sphere(c, r, material=grains_mat) for c, r in cloud])
-    O.engines = _engines(Vector3(0, 0, -g), damping=0.4)
+    O.engines = _engines(Vector3(0, 0, -g), damping=0.4, threads=threads)
     O.dt = 0.5 * utils.PWaveTimeStep()
     grains = [b.id for b in O.bodies if isinstance(b.shape, w.Sphere)]
     deposition_steps = _settle(max_steps, grains, unbalanced=0.1, speed=2e-2)
