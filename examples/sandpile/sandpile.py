@@ -79,6 +79,9 @@ parser.add_argument("--lid-friction", type=float, default=0.0,
 parser.add_argument("--base", choices=("frictional", "fixed"), default="frictional",
                     help="the flume base: a Coulomb contact with the scene's base friction angle (default), or fixed (no slip, no lift-off)")
 parser.add_argument("--head-start", type=float, help="inflow water level at the start, also the pile's starting water table [m] (default the scene's 0.03 m)")
+parser.add_argument("--water-bulk-modulus", type=float, metavar="KW",
+                    help="the water's bulk modulus Kw [Pa] (default the scene's: 2.2e8, lowered for the explicit step, which follows "
+                         "the undrained wave; --submerged 2.2e9, real water, which the semi-implicit step affords)")
 parser.add_argument("--side-wall-friction", type=float, default=0.0, metavar="MU",
                     help="Coulomb coefficient μ = tan δ of the flume's front and rear walls (y), a frictional contact (theory.md eq. 2.6); "
                          "0 (default): smooth slip walls, the plane-strain pile")
@@ -108,6 +111,10 @@ if args.ramp_time is not None or args.hold_time is not None or args.head_start i
                                 hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time,
                                 head_start=SCENE.head_start if args.head_start is None else args.head_start,
                                 head_end=SCENE.head_end if args.head_end is None else args.head_end)
+if args.water_bulk_modulus is not None:
+    if not args.water_bulk_modulus > 0:
+        raise ValueError("--water-bulk-modulus = %r Pa is outside the valid range (0, inf)" % args.water_bulk_modulus)
+    SCENE = dataclasses.replace(SCENE, water_bulk_modulus=args.water_bulk_modulus)
 SAND_SOURCE = "yade_mpm.sandpile (documented lab-scale sand)"
 if args.sand_from_dem is not None:
     dem_summary_path = os.path.join(args.sand_from_dem, "summary.json")
@@ -261,14 +268,17 @@ failure = None
 settled = None
 stopped = None  # the solver's message if the run went unstable: what was recorded up to then is kept
 wall_start = time.time()
+solver_time = 0.0  # wall time in the steps (HDF5 frames included), without this script's records and checks [s]
 record = 0
 while O.time < DURATION - 1e-12:
     recorder.dead = record % records_per_frame != 0
     try:
+        steps_start = time.time()
         for _ in range(steps_per_record):
             engine.drainedWaterTable = head_table(O.time)
-            O.run(1, True)
+            O.step()  # synchronous in this thread: O.run(1, True) waits on YADE's thread for tens of ms per call
             recorder.dead = True
+        solver_time += time.time() - steps_start
     except RuntimeError as error:
         # the solver went unstable, or the soil rose above the still water (the submerged model's
         # premise, theory.md eq. 1.9, no longer holds): stop and keep what was recorded
@@ -396,6 +406,8 @@ summary = {
     "mode": "quick" if args.quick else "full",
     "cell_size_m": CELL,
     "points_per_phase_initial": int(len(positions)),
+    "solid_points": int(solid.count),
+    "water_points_end": int(fluid.count),
     "scene": {k: getattr(SCENE, k) for k in SCENE.__dataclass_fields__},
     "sand_strength_source": SAND_SOURCE,
     "side_wall_friction": args.side_wall_friction,
@@ -409,6 +421,7 @@ summary = {
     "explicit_steps": int(engine.solverSteps),
     "critical_time_step_s": engine.criticalTimeStep,
     "run_time_s": run_time,
+    "solver_time_s": solver_time,
     "peak_memory_MiB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,  # of this process (YADE included)
     "threads": int(O.numThreads),
     "stable_before_rise": {"toe_displacement_m": settled["toe_displacement_m"] if settled else None,

@@ -21,6 +21,14 @@ struct PointFieldNames {
 	const char* externalForce       = "externalForce";
 };
 
+// One point's 1D stencil weights along x, y, z. Its constructor leaves them unset, so that
+// resizing the cache below writes nothing: every entry is filled right after (a value-initialised
+// std::array would be zeroed first, a pass over the whole cache in every step).
+struct StencilWeights : std::array<Weights1D, 3> {
+	StencilWeights() {}
+	StencilWeights(const Weights1D& x, const Weights1D& y, const Weights1D& z) : std::array<Weights1D, 3> { x, y, z } {}
+};
+
 // Fields every material point carries, whatever its phase.
 struct MaterialPointSet {
 	std::vector<Vec3> position;   // x_p [m]
@@ -31,7 +39,7 @@ struct MaterialPointSet {
 	// Solver scratch, not point data: the 1D stencil weights of every point at its current position
 	// (theory.md eq. 3.2), computed once for the stages of a step that share the positions and
 	// empty otherwise (TwoPhaseSolver::cacheStencilWeights): valid exactly when it has size() entries.
-	std::vector<std::array<Weights1D, 3>> stencilWeights;
+	std::vector<StencilWeights> stencilWeights;
 
 	std::size_t size() const { return position.size(); }
 	// Check that every field has size() entries and holds finite, admissible values; throws

@@ -373,7 +373,7 @@ template <class Kernel> void TwoPhaseSolver::cacheStencilWeights()
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			detail::weightsAt<Kernel>(grid_, P.position[p], P.halfLength[p], w);
-			P.stencilWeights[p] = { w[0], w[1], w[2] };
+			P.stencilWeights[p] = StencilWeights(w[0], w[1], w[2]);
 		}
 	};
 	for (SolidSet& s : solids_) fill(*s.points);
