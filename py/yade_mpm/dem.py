@@ -24,6 +24,14 @@ from yade import O, Vector3
 XMIN, XMAX, YMIN, YMAX, ZMIN, ZMAX = range(6)
 
 
+def run_steps(count):
+    """Advance the scene `count` steps in this thread (O.step). O.run(count, True) hands them to YADE's
+    run thread and waits for its end in 40 ms polls, most of the wall time of the short chunks the
+    loops here step in (measured: 40 ms per O.run(1, True) with no engines)."""
+    for _ in range(int(count)):
+        O.step()
+
+
 @dataclass
 class OedometerSample:
     """A compacted sphere assembly in a box of walls, ready for oedometric loading."""
@@ -122,7 +130,7 @@ def _compacted_box(grains, width, stress, young, contact_poisson, friction_angle
         w.NewtonIntegrator(damping=0.2),
     ]
     for _ in range(200):
-        O.run(1000, True)
+        run_steps(1000)
         if utils.unbalancedForce() < 1e-3 and abs(controller.meanStress + stress) < 1e-3 * stress:
             break
     else:
@@ -177,7 +185,7 @@ def settle(sample, stress, tolerance=2e-3, max_steps=100000):
     O.forces.setPermF(sample.wall_ids[ZMAX], Vector3(0, 0, -stress * sample.area))
     steps = 0
     while steps < max_steps:
-        O.run(500, True)
+        run_steps(500)
         steps += 500
         plate = O.bodies[sample.wall_ids[ZMAX]].state.vel[2]
         if utils.unbalancedForce() < 1e-3 and abs(sample.vertical_stress() - stress) < tolerance * stress and abs(plate) < 1e-6:
@@ -259,7 +267,7 @@ def measure_permeability(sample, viscosity, pressure_drop=1.0):
     saved = [(b.state.vel, b.state.angVel, b.state.blockedDOFs) for b in bodies]
     for b in bodies:
         b.state.vel, b.state.angVel, b.state.blockedDOFs = Vector3(0, 0, 0), Vector3(0, 0, 0), "xyzXYZ"
-    O.run(2, True)  # the second step solves on the new mesh (see _configure_flow)
+    run_steps(2)  # the second step solves on the new mesh (see _configure_flow)
     for b, (vel, ang, dofs) in zip(bodies, saved):
         b.state.vel, b.state.angVel, b.state.blockedDOFs = vel, ang, dofs
     inflow, outflow = flow.getBoundaryFlux(sample.wall_ids[ZMIN]), flow.getBoundaryFlux(sample.wall_ids[ZMAX])
@@ -286,7 +294,7 @@ def consolidate(sample, load, viscosity, times, depths=(0.3, 0.5, 0.7, 0.9), tim
     for target in times:
         steps = int(round((target - (O.time - start)) / time_step))
         if steps > 0:
-            O.run(steps, True)
+            run_steps(steps)
         top = O.bodies[sample.wall_ids[ZMAX]].state.pos[2]
         base = O.bodies[sample.wall_ids[ZMIN]].state.pos[2]
         centre = 0.5 * sample.width
@@ -318,7 +326,7 @@ def drained_triaxial(grains=300, confinement=10e3, friction_angle=math.radians(3
                                           rolling_resistance, radius_spread)
     controller.internalCompaction = False
     for _ in range(40):  # back to isotropic equilibrium with the final friction, walls servo-controlled
-        O.run(500, True)
+        run_steps(500)
         if utils.unbalancedForce() < 1e-3 and abs(controller.meanStress + confinement) < 1e-3 * confinement:
             break
     controller.stressMask = 3  # x and y walls hold σ3; z follows the strain rate
@@ -327,7 +335,7 @@ def drained_triaxial(grains=300, confinement=10e3, friction_angle=math.radians(3
     axial0, volumetric0 = controller.strain[2], controller.volumetricStrain
     curves = {"axial_strain": [], "volumetric_strain": [], "sigma1": [], "sigma3": []}
     while True:
-        O.run(200, True)
+        run_steps(200)
         axial = -(controller.strain[2] - axial0)
         curves["axial_strain"].append(axial)
         curves["volumetric_strain"].append(-(controller.volumetricStrain - volumetric0))

@@ -33,7 +33,7 @@ import numpy as np
 import yade.wrapper as w
 from yade import O, Vector3
 
-from .dem import XMAX, XMIN, ZMAX, _require, contact_loop, contact_material, switch_flow_on
+from .dem import XMAX, XMIN, ZMAX, _require, contact_loop, contact_material, run_steps, switch_flow_on
 
 
 RADIUS_SPREAD = 0.15  # the pile grains' radii: uniform within ± this fraction of their mean [-]
@@ -79,7 +79,7 @@ def _settle(max_steps, grain_ids, unbalanced=0.01, speed=1e-4):
     from yade import utils
     steps = 0
     while steps < max_steps:
-        O.run(500, True)
+        run_steps(500)
         steps += 500
         fastest = max((O.bodies[int(i)].state.vel.norm() for i in grain_ids), default=0.0)
         if utils.unbalancedForce() < unbalanced and fastest < speed:
