@@ -279,9 +279,9 @@ while O.time < DURATION - 1e-12:
             O.step()  # synchronous in this thread: O.run(1, True) waits on YADE's thread for tens of ms per call
             recorder.dead = True
         solver_time += time.time() - steps_start
-    except RuntimeError as error:
-        # the solver went unstable, or the soil rose above the still water (the submerged model's
-        # premise, theory.md eq. 1.9, no longer holds): stop and keep what was recorded
+    except (RuntimeError, ValueError) as error:
+        # the solver went unstable (RuntimeError), or the soil rose above the still water (ValueError:
+        # the submerged model's premise, theory.md eq. 1.9, no longer holds): stop and keep what was recorded
         if "unstable" not in str(error) and "needs the soil under the still water" not in str(error):
             raise
         stopped = "t = %.4f s: %s" % (O.time, error)
