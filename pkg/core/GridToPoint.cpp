@@ -89,8 +89,7 @@ namespace stages {
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, P, p, w);
-			for (int d = 0; d < 3; ++d)
-				if (!std::isfinite(P.position[p][d]) || w[d].first < 0 || w[d].first + Kernel::stencil > grid.nodes[d]) first = std::min(first, static_cast<long>(p));
+			if (stencilOffGrid<Kernel>(grid, P.position[p], w)) first = std::min(first, static_cast<long>(p));
 		}
 		return first == static_cast<long>(count) ? -1 : first;
 	}

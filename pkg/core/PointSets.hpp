@@ -40,6 +40,9 @@ struct MaterialPointSet {
 	// (theory.md eq. 3.2), computed once for the stages of a step that share the positions and
 	// empty otherwise (TwoPhaseSolver::cacheStencilWeights): valid exactly when it has size() entries.
 	std::vector<StencilWeights> stencilWeights;
+	// With the cache: the first point whose stencil leaves the grid (or whose position is not finite),
+	// found while filling it, or −1 (TwoPhaseSolver::throwIfOutsideGrid reads it instead of a pass of its own).
+	long firstOffGrid = -1;
 
 	std::size_t size() const { return position.size(); }
 	// Check that every field has size() entries and holds finite, admissible values; throws

@@ -34,6 +34,14 @@ namespace mpm::detail {
 		weightsAt<Kernel>(g, P.position[p], P.halfLength[p], w);
 	}
 
+	// True where a point at x with these weights has a non-finite position or a stencil that leaves the grid.
+	template <class Kernel> inline bool stencilOffGrid(const GridGeometry& g, const Vec3& x, const Weights1D (&w)[3])
+	{
+		for (int d = 0; d < 3; ++d)
+			if (!std::isfinite(x[d]) || w[d].first < 0 || w[d].first + Kernel::stencil > g.nodes[d]) return true;
+		return false;
+	}
+
 	// Node indices of the stencil per axis, wrapped along periodic axes (theory.md §2.7):
 	// node[d][a] is the a-th stencil node along axis d.
 	template <int S> inline void stencilNodes(const GridGeometry& g, const Weights1D (&w)[3], int (&node)[3][S])

@@ -354,6 +354,7 @@ template <class Kernel> void TwoPhaseSolver::stepWith(Real dt)
 	if (projectedRates) skeletonRates<Kernel>();  // S4a, eq. 8.9: from v^{n+1} at x^n
 	movePoints<Kernel>(dt);                       // Step 7, eq. 4.11; water in and out, eqs. 2.4–2.5
 	cacheStencilWeights<Kernel>();                // §4 stencil weights at x^{n+1}, for Steps 8–10
+	throwIfOutsideGrid(false);                    // every stencil on the grid (found while caching)
 	remap<Kernel>(wet, !projectedRates);          // Step 8, eq. 4.12
 	if (!projectedRates) skeletonRates<Kernel>(); // eq. 4.13, from the re-mapped v̂ at x^{n+1}
 	updateSkeleton(dt);                           // Step 9, eqs. 4.13–4.15, §7
@@ -369,12 +370,15 @@ template <class Kernel> void TwoPhaseSolver::cacheStencilWeights()
 	auto       fill = [&](MaterialPointSet& P) {
 		const std::size_t count = P.size();
 		P.stencilWeights.resize(count);
-#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		long first = static_cast<long>(count);
+#pragma omp parallel for schedule(static) reduction(min : first) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			detail::weightsAt<Kernel>(grid_, P.position[p], P.halfLength[p], w);
 			P.stencilWeights[p] = StencilWeights(w[0], w[1], w[2]);
+			if (detail::stencilOffGrid<Kernel>(grid_, P.position[p], w)) first = std::min(first, static_cast<long>(p));
 		}
+		P.firstOffGrid = first == static_cast<long>(count) ? -1 : first;
 	};
 	for (SolidSet& s : solids_) fill(*s.points);
 	for (WaterPointSet* w : waters_) fill(*w);
@@ -601,7 +605,6 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 	}
 	removeOutflowingWater();
 	injectInflowingWater();
-	throwIfOutsideGrid(false);
 }
 
 // The skeleton's velocity gradients (eq. 4.13) and, with cell averaging, their cell-averaged traces
@@ -990,8 +993,10 @@ void TwoPhaseSolver::markInflowCellPoints()
 void TwoPhaseSolver::throwIfOutsideGrid(bool setup) const
 {
 	auto check = [&](const MaterialPointSet& set, const std::string& name) {
-		const long p = settings_.shapeFunction == ShapeFunction::Linear ? stages::firstPointOutsideGrid<LinearKernel>(grid_, set)
-		                                                                 : stages::firstPointOutsideGrid<GimpKernel>(grid_, set);
+		// found while filling the weights cache where it is filled, else a pass of its own
+		const long p = !set.stencilWeights.empty() && set.stencilWeights.size() == set.size() ? set.firstOffGrid
+		               : settings_.shapeFunction == ShapeFunction::Linear                      ? stages::firstPointOutsideGrid<LinearKernel>(grid_, set)
+		                                                                                      : stages::firstPointOutsideGrid<GimpKernel>(grid_, set);
 		if (p < 0) return;
 		std::ostringstream msg;
 		if (!setup) msg << "unstable in solver step " << steps_ << ": ";
