@@ -3,7 +3,7 @@
 # (h = 2 cm) and full (h = 1 cm) sand pile of examples/sandpile/sandpile.py, explicit at the scene's
 # lowered Kw = 2.2e8 Pa and at real water, against the semi-implicit step at real water, on
 # MPM_BENCH_PILE_THREADS threads (default 2), median of MPM_BENCH_PILE_REPEATS runs (default 3) of a
-# short stretch of the still-water phase; writes the table to doc/benchmarks.md (between the PILE
+# short stretch of the settling phase (head held at its start); writes the table to doc/benchmarks.md (between the PILE
 # markers). The rate is the run's solver_time_s (the steps, without the example's records and
 # limit-equilibrium checks) over its simulated time.
 set -euo pipefail
@@ -35,7 +35,7 @@ for line in open(sys.argv[1]).read().splitlines():
 from yade_mpm import sandpile
 laboratory, compressed = sandpile.SUBMERGED.duration(), sandpile.DEFAULT.duration()
 lines = ["Measured on %s, %s threads, median of %s runs. Solver wall seconds per simulated second (the steps, without the example's "
-         "records and limit-equilibrium checks) over a stretch of the still-water phase, and what that rate gives for the scene's "
+         "records and limit-equilibrium checks) over a stretch of the settling phase (head held at its start), and what that rate gives for the scene's "
          "compressed head history (%.2f s) and for the laboratory one of the submerged pile (%.0f s: a minute's rise)." % (sys.argv[3], sys.argv[4], sys.argv[5], compressed, laboratory),
          "", "| pile | scheme | Kw [Pa] | soil points | water points | Δt [s] | wall s per simulated s | compressed history [min] | laboratory history [h] | vs explicit at Kw 2.2e8 |",
          "|---|---|---|---|---|---|---|---|---|---|"]
