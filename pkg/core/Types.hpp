@@ -20,8 +20,10 @@ using Voigt6 = Eigen::Matrix<Real, 6, 1>; // (xx, yy, zz, xy, yz, zx)
 
 // Loops over fewer items than this run on one thread: below it OpenMP's fork/join costs more
 // than the work. (At 4096 the 2450-point sets of the quick sand pile ran on one thread; at 1024
-// two threads run them 1.45× faster on the 2-core VM.)
-constexpr std::size_t parallelThreshold = 1024;
+// two threads ran them 1.45× faster on the 2-core VM; at 256 the semi-implicit pile's 870 water
+// points, whose pressure assembly is its largest stage, run on both too: its steps on two threads
+// took 3.85 instead of 5.02 s per 0.1 s simulated, 5.64 s on one; medians of 3, 2026-11-27.)
+constexpr std::size_t parallelThreshold = 256;
 
 inline Mat3 voigtToMatrix(const Voigt6& s)
 {
