@@ -111,9 +111,7 @@ if args.ramp_time is not None or args.hold_time is not None or args.head_start i
                                 hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time,
                                 head_start=SCENE.head_start if args.head_start is None else args.head_start,
                                 head_end=SCENE.head_end if args.head_end is None else args.head_end)
-if args.water_bulk_modulus is not None:
-    if not args.water_bulk_modulus > 0:
-        raise ValueError("--water-bulk-modulus = %r Pa is outside the valid range (0, inf)" % args.water_bulk_modulus)
+if args.water_bulk_modulus is not None:  # MpmWaterMat refuses a value outside (0, inf] below, before any work
     SCENE = dataclasses.replace(SCENE, water_bulk_modulus=args.water_bulk_modulus)
 SAND_SOURCE = "yade_mpm.sandpile (documented lab-scale sand)"
 if args.sand_from_dem is not None:
