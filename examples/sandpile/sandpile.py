@@ -20,9 +20,11 @@ stiffness, porosity and permeability from the oedometer and flow test on them).
 Writes to DIR (default examples/sandpile/out[-quick]):
   sandpile.h5 + sandpile.xdmf     point fields over time (ParaView)
   pore_pressure.png               pore pressure at four times (x–z view)
-  velocity_at_failure.png         solid velocity field at failure
+  velocity_at_failure.png         solid velocity field at failure (or at the end)
+  runout.png                      the pile's surface at up to six frame times (the run-out sequence)
   shear_band.png                  plastic shear strain with the extracted sliding surface
   time_series.png                 head, pore pressure at probes, slope-face and toe displacement,
+                                  solid kinetic energy, water injected, removed and stored,
                                   Bishop's factor of safety on the run's own pore pressures
   time_series.csv                 the same numbers
   summary.json                    failure head and time, kinematic onset (onset_head_m), run-out
@@ -50,6 +52,7 @@ import time
 import numpy as np
 
 import yade_mpm
+import yade_mpm.plotting
 from yade import O
 from yade_mpm import MpmHdf5Recorder, MpmSoilMat, MpmTwoPhaseEngine, MpmWaterMat, calibrate, sandpile
 
@@ -260,6 +263,8 @@ O.stopAtTime = DURATION  # the end of the head history; also what the progress E
 steps_per_record = int(round(RECORD_INTERVAL / O.dt))
 records_per_frame = int(round(FIELD_INTERVAL / RECORD_INTERVAL))
 rows, snapshots = [], {}
+profiles = []  # (time, x, height) of the pile's surface at each HDF5 frame: the run-out sequence
+PROFILE_BINS = np.arange(0, SCENE.flume_length + spacing, 2 * spacing)
 record_positions = []  # the solid points' positions at each record (float32): the first mobilised zone is read at the onset
 lem_records = []  # (time, head, critical circle, critical circle ≥ DEEP_SLIDE_CELLS deep or None) of each limit-equilibrium evaluation
 failure = None
@@ -308,6 +313,7 @@ while O.time < DURATION - 1e-12:
             deep = deep_peak = None
         row["lem_factor_of_safety"] = circle.factor
         lem_records.append((O.time, row["head_m"], circle, deep, deep_peak))
+        profiles.append((O.time, *yade_mpm.analysis.deposit_profile(solid.pos, PROFILE_BINS, half_height=0.5 * spacing)))
     rows.append(row)
     record_positions.append(solid.pos.astype(np.float32))
     if settled is None and O.time >= SCENE.settle_time - 1e-9:
@@ -396,7 +402,7 @@ first_zone = None
 if onset_index is not None and settled is not None:
     first_zone = yade_mpm.analysis.mobilised_zone(rise_start_positions, record_positions[onset_index])
 runout = yade_mpm.analysis.toe_runout(start_positions, solid.pos, toe_x=float(start_positions[:, 0].max()), base_band=2 * CELL)
-deposit_x, deposit_z = yade_mpm.analysis.deposit_profile(solid.pos, np.arange(0, SCENE.flume_length + spacing, 2 * spacing), half_height=0.5 * spacing)
+deposit_x, deposit_z = yade_mpm.analysis.deposit_profile(solid.pos, PROFILE_BINS, half_height=0.5 * spacing)
 mobilised, mobilised_fraction = yade_mpm.analysis.mobilised_volume(start_positions, solid.pos, solid.volume, displacement=spacing)
 
 stored, residual = mass_balance()
@@ -454,94 +460,35 @@ with open(os.path.join(OUT, "time_series.csv"), "w", newline="") as f:
     writer.writeheader()
     writer.writerows(rows)
 
-# --- figures ---------------------------------------------------------------------------------------
-import matplotlib  # noqa: E402
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-xs = np.linspace(0, SCENE.flume_length, 200)
-outline = SCENE.surface_height(xs)
+# --- figures (yade_mpm.plotting) ---------------------------------------------------------------------
+x_max = toe + 0.1
 if SUBMERGED:  # excess pressures: at most the final excess head, no suction
     pmax = SCENE.water_density * G * (SCENE.head_end - SCENE.still_water_level)
     pmin = -0.1 * pmax
 else:
     pmax = SCENE.water_density * G * SCENE.head_end  # hydrostatic at the base under the final head [Pa]
     pmin = -SCENE.water_density * G * (SCENE.pile_height - SCENE.head_start)  # suction at the crest at the start [Pa]
-
-
-def frame(ax, title):
-    ax.plot(xs, outline, "k--", lw=0.8)
-    ax.set_xlim(0, min(SCENE.flume_length, toe + 0.1))
-    ax.set_ylim(0, SCENE.pile_height * 1.3)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("z [m]")
-    ax.set_title(title, fontsize=9)
-
-
-fig, axes = plt.subplots(len(snapshots), 1, figsize=(7, 2.2 * len(snapshots)))
-for ax, (label, (t, pos, p)) in zip(np.atleast_1d(axes), sorted(snapshots.items(), key=lambda kv: kv[1][0])):
-    order = np.argsort(pos[:, 1])  # nearest the viewer (front wall y = 0) drawn last
-    sc = ax.scatter(pos[order, 0], pos[order, 2], c=p[order], s=6, cmap="RdYlBu_r",
-                    norm=matplotlib.colors.TwoSlopeNorm(vmin=pmin, vcenter=0, vmax=pmax))
-    frame(ax, "%s: t = %.2f s, head %.3f m" % (label, t, SCENE.head(t)))
-    fig.colorbar(sc, ax=ax, label="p [Pa] (< 0: suction)")
-fig.tight_layout()
-fig.savefig(os.path.join(OUT, "pore_pressure.png"), dpi=110)
-
+yade_mpm.plotting.pore_pressure_snapshots(os.path.join(OUT, "pore_pressure.png"),
+                                          [(name, t, SCENE.head(t), pos, p) for name, (t, pos, p) in snapshots.items()], SCENE, x_max, (pmin, pmax))
 pos, vel = failure_state
-slab = np.abs(pos[:, 1] - 0.5 * SCENE.flume_width) < 0.5 * CELL
-fig, ax = plt.subplots(figsize=(7, 3))
-speed = np.linalg.norm(vel, axis=1)
-q = ax.quiver(pos[slab, 0], pos[slab, 2], vel[slab, 0], vel[slab, 2], speed[slab], cmap="plasma", scale_units="xy",
-              scale=max(speed[slab].max(), 1e-12) / (1.5 * spacing), width=0.003)
-fig.colorbar(q, ax=ax, label="|v_s| [m/s]")
-frame(ax, "solid velocity at %s (t = %.2f s), mid-width slab" % ("failure" if failure else "the end", failure["time_s"] if failure else O.time))
-fig.tight_layout()
-fig.savefig(os.path.join(OUT, "velocity_at_failure.png"), dpi=110)
-
-fig, ax = plt.subplots(figsize=(7, 3))
-kappa = solid.plasticShearStrain
-sc = ax.scatter(start_positions[:, 0], start_positions[:, 2], c=kappa, s=6, cmap="magma_r", vmin=0, vmax=max(np.percentile(kappa, 99), 1e-6))
-fig.colorbar(sc, ax=ax, label="κ, plastic shear strain [-]")
-if len(surface_x):
-    ax.plot(surface_x, surface_z, "c-", lw=2, label="sliding surface (base of the band κ > %.2f)" % BAND_STRAIN)
+yade_mpm.plotting.velocity_field(os.path.join(OUT, "velocity_at_failure.png"), pos, vel, SCENE, x_max,
+                                 (0.5 * SCENE.flume_width - 0.5 * CELL, 0.5 * SCENE.flume_width + 0.5 * CELL), 1.5 * spacing,
+                                 "solid velocity at %s (t = %.2f s), mid-width slab" % ("failure" if failure else "the end", failure["time_s"] if failure else O.time))
+critical = None
 if lem_records:  # the critical circle at the LEM onset, or where F was lowest
     below = [r for r in lem_records if r[2].factor < 1]
     t_c, h_c, circle = (below[0] if below else min(lem_records, key=lambda r: r[2].factor))[:3]
-    ax.plot(*circle.surface(), "g--", lw=1.5, label="Bishop's critical circle, F = %.2f at t = %.2f s" % (circle.factor, t_c))
-if len(surface_x) or lem_records:
-    ax.legend(fontsize=8, loc="upper right")
-frame(ax, "plastic shear strain at t = %.2f s on the undeformed pile" % O.time)
-fig.tight_layout()
-fig.savefig(os.path.join(OUT, "shear_band.png"), dpi=110)
-
-t = np.array([r["time_s"] for r in rows])
-fig, (a1, a2, a3, a4) = plt.subplots(4, 1, figsize=(7, 9), sharex=True)
-a1.plot(t, [r["head_m"] for r in rows])
-a1.set_ylabel("inflow head H [m]")
-for key in rows[0]:
-    if key.startswith("p_"):
-        a2.plot(t, [r[key] for r in rows], label=key[2:-3].replace("_", " "))
-a2.set_ylabel("pore pressure [Pa]")
-a2.legend(fontsize=7)
-a3.plot(t, 1e3 * np.array([r["face_displacement_m"] for r in rows]), label="lower slope face (mean |u|)")
-a3.plot(t, 1e3 * np.array([r["toe_displacement_m"] for r in rows]), label="toe region (mean u_x)")
-a3.axhline(1e3 * FAILURE_DISPLACEMENT, color="r", ls=":", label="failure criterion")
-a3.set_ylabel("displacement [mm]")
-a3.legend(fontsize=7)
-a4.plot([r[0] for r in lem_records], [r[2].factor for r in lem_records], "o-", label="Bishop, Davis strength, run's own p")
-a4.plot([r[0] for r in lem_records], [math.nan if r[3] is None else r[3].factor for r in lem_records], "s--", label="the same, slides ≥ %d cells deep" % DEEP_SLIDE_CELLS)
-a4.plot([r[0] for r in lem_records], [math.nan if r[4] is None else r[4].factor for r in lem_records], "^:", label="slides ≥ %d cells deep, peak strength (no Davis)" % DEEP_SLIDE_CELLS)
-a4.axhline(1, color="k", lw=0.8)
-a4.set_ylabel("LEM factor of safety [-]")
-a4.set_xlabel("t [s]")
-a4.legend(fontsize=7)
-if failure:
-    for a in (a1, a2, a3, a4):
-        a.axvline(failure["time_s"], color="r", lw=0.8)
-fig.tight_layout()
-fig.savefig(os.path.join(OUT, "time_series.png"), dpi=110)
+    critical = (*circle.surface(), "Bishop's critical circle, F = %.2f at t = %.2f s" % (circle.factor, t_c))
+yade_mpm.plotting.plastic_shear_strain(os.path.join(OUT, "shear_band.png"), start_positions, solid.plasticShearStrain, SCENE, x_max,
+                                       "plastic shear strain at t = %.2f s on the undeformed pile" % O.time,
+                                       surface=(surface_x, surface_z, "sliding surface (base of the band κ > %.2f)" % BAND_STRAIN), circle=critical)
+yade_mpm.plotting.runout_sequence(os.path.join(OUT, "runout.png"), profiles + [(O.time, deposit_x, deposit_z)], SCENE, x_max)
+yade_mpm.plotting.time_series(os.path.join(OUT, "time_series.png"), {key: [r[key] for r in rows] for key in rows[0]},
+                              lem=([r[0] for r in lem_records],
+                                   {"Bishop, Davis strength, run's own p": [r[2].factor for r in lem_records],
+                                    "the same, slides ≥ %d cells deep" % DEEP_SLIDE_CELLS: [None if r[3] is None else r[3].factor for r in lem_records],
+                                    "slides ≥ %d cells deep, peak strength (no Davis)" % DEEP_SLIDE_CELLS: [None if r[4] is None else r[4].factor for r in lem_records]}),
+                              failure_displacement=FAILURE_DISPLACEMENT, failure_time=failure["time_s"] if failure else None)
 print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "stopped_unstable", "failure", "sliding_surface", "water_mass_balance", "stable_before_rise")}, indent=2))
 print(json.dumps({k: lem_summary[k] for k in ("lem_onset_head_m", "factors", "lem_deep_onset_head_m", "deep_factors", "lem_deep_peak_onset_head_m", "deep_peak_factors")}))
 print(json.dumps({k: summary[k] for k in ("onset", "kinetic_onset", "runout_m", "mobilised_fraction")}))

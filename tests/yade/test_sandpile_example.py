@@ -15,7 +15,7 @@ import pytest
 
 from conftest import start_quick_sandpile
 
-OUTPUTS = ["summary.json", "time_series.csv", "time_series.png", "pore_pressure.png", "velocity_at_failure.png", "shear_band.png",
+OUTPUTS = ["summary.json", "time_series.csv", "time_series.png", "pore_pressure.png", "velocity_at_failure.png", "shear_band.png", "runout.png",
            "sandpile.h5", "sandpile.xmf"]
 
 

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Regenerates the figures in doc/ (not a test). Usage: scripts/figures.sh [oedometer|compare|pile ...] [--full]
+# (no part named: all three). On 2 cores:
+#   oedometer  scripts/validate.sh: doc/figures/oedometer_*, the table of doc/validation.md (3-4 min)
+#   compare    scripts/compare.sh: doc/compare/ (MPM against DEM + PFV), doc/tradeoffs.md and
+#              doc/figures/tradeoffs.* (20-40 min; see that script for reusing stored runs)
+#   pile       examples/sandpile/sandpile.py, quick mode (h = 2 cm):
+#              - the main job's scene (yade_mpm.sandpile.DEFAULT, explicit): doc/figures/sandpile_quick_* (3 min)
+#              - the submerged pile on the laboratory head history (yade_mpm.sandpile.SUBMERGED, semi-implicit,
+#                α = 100, crest lid; doc/sandpile.md): doc/figures/sandpile_lab_quick_* (10 min)
+#              with --full also the main job's scene at h = 1 cm: doc/figures/sandpile_full_* (about 1 h)
+# Each pile run's summary.json is copied next to its figures, so that doc/ states which run drew them.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+build="${MPM_BUILD_DIR:-$root/build}"
+parts=()
+full=0
+for arg in "$@"; do
+  case "$arg" in
+    --full) full=1 ;;
+    oedometer|compare|pile) parts+=("$arg") ;;
+    *) echo "scripts/figures.sh: unknown argument '$arg' (valid: oedometer, compare, pile, --full)" >&2; exit 2 ;;
+  esac
+done
+[ ${#parts[@]} -gt 0 ] || parts=(oedometer compare pile)
+[ -f "$build/python/yade_mpm/_yade_mpm.so" ] || "$root/scripts/build.sh"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+figures="$root/doc/figures"
+mkdir -p "$figures"
+
+# run_pile NAME ARGS...: one example run, its figures and summary copied to doc/figures/sandpile_NAME_*
+run_pile() {
+  local name="$1"
+  shift
+  local out="$work/$name"
+  echo "== sand pile '$name': examples/sandpile/sandpile.py $*"
+  PYTHONPATH="$build/python" HOME="$work" yade-double -j2 -n -x "$root/examples/sandpile/sandpile.py" "$@" --out "$out" > "$work/$name.log" 2>&1 \
+    || { tail -40 "$work/$name.log"; exit 1; }
+  for figure in pore_pressure velocity_at_failure shear_band runout time_series; do
+    cp "$out/$figure.png" "$figures/sandpile_${name}_$figure.png"
+  done
+  cp "$out/summary.json" "$figures/sandpile_${name}_summary.json"
+}
+
+for part in "${parts[@]}"; do
+  case "$part" in
+    oedometer) "$root/scripts/validate.sh" ;;
+    compare) "$root/scripts/compare.sh" ;;
+    pile)
+      run_pile quick --quick
+      run_pile lab_quick --quick --submerged --scheme semi-implicit --inertia-scale 100 --crest-lid --lid-friction 0.7
+      [ "$full" = 0 ] || run_pile full
+      ;;
+  esac
+done
