@@ -1,0 +1,187 @@
+"""Speed for accuracy of the sand pile (issue 15): what each cost knob does to the pile's answer.
+
+    python3 -m yade_mpm.pile_tradeoffs --runs DIR [--machine TEXT] [--doc doc/tradeoffs.md] [--figure PNG]
+
+DIR holds runs of examples/sandpile/sandpile.py (each a directory with summary.json and time_series.csv)
+and an `index` file, a line per run: `name knob setting` (scripts/tradeoffs-pile.sh writes both). Each
+knob's runs are set against its reference run — the most accurate setting where there is one (α = 1,
+the finer cell, more points per cell), else the baseline — on three answers: the excess head over the
+still water at the onset (the slope face's compliance, yade_mpm.analysis.compliance_onset), the onset's
+time after the rise began, and the slope face's displacement at the end; a knob whose every run stays
+within `SAFE` of its reference on all three is a safe speed knob.
+"""
+import argparse
+import json
+import math
+import os
+import re
+import sys
+
+from .compare_pile import read_run
+
+SAFE = 0.05  # relative change of every answer that still counts as "the same" [-]
+MOST_ACCURATE = {"inertia_scale": "alpha1", "cell_size": "full", "points_per_cell": "ppc3"}  # knob → reference run (else the baseline)
+
+
+def collect(runs_dir):
+    """The runs listed in runs_dir/index: dicts with the run's name, knob, setting and answers."""
+    rows = []
+    with open(os.path.join(runs_dir, "index")) as f:
+        for line in f.read().splitlines():
+            if not line.strip():
+                continue
+            name, knob, setting = line.split()[:3]
+            summary, columns = read_run(os.path.join(runs_dir, name))
+            scene = summary["scene"]
+            still = scene["still_water_level"] if scene.get("still_water_level") is not None else 0.0
+            onset = summary.get("onset")
+            rows.append({
+                "name": name, "knob": knob, "setting": setting,
+                "onset_excess_head_m": None if onset is None else onset["head_m"] - still,
+                "onset_time_after_rise_s": None if onset is None else onset["time_s"] - scene["settle_time"],
+                "lem_deep_onset_excess_head_m": None if summary.get("lem_deep_onset_head_m") is None else summary["lem_deep_onset_head_m"] - still,
+                "face_displacement_end_m": float(columns["face_displacement_m"][-1]),
+                "toe_displacement_end_m": float(columns["toe_displacement_m"][-1]),
+                "runout_m": summary.get("runout_m"),
+                "simulated_time_s": summary["simulated_time_s"],
+                "solver_time_s": summary["solver_time_s"],
+                "solid_points": summary["solid_points"],
+                "inertia_scale_release_time_s": summary.get("inertia_scale_release_time_s"),
+                "stopped_unstable": summary.get("stopped_unstable"),
+            })
+    return rows
+
+
+ANSWERS = ("onset_excess_head_m", "onset_time_after_rise_s", "face_displacement_end_m")
+
+
+def relative_changes(rows):
+    """Per run, the relative change of each answer against its knob's reference run (None where an
+    answer or the reference is missing), and the reference's name."""
+    by_name = {r["name"]: r for r in rows}
+    out = {}
+    for r in rows:
+        reference = by_name.get(MOST_ACCURATE.get(r["knob"], "baseline"), by_name.get("baseline"))
+        changes = {}
+        for key in ANSWERS:
+            a, b = r[key], None if reference is None else reference[key]
+            changes[key] = None if a is None or b is None or b == 0 else (a - b) / abs(b)
+        out[r["name"]] = (None if reference is None else reference["name"], changes)
+    return out
+
+
+def safe_knobs(rows, changes):
+    """Knobs whose every run stays within SAFE of its reference on every answer (runs without an
+    onset count as a change)."""
+    knobs = {}
+    for r in rows:
+        if r["knob"] == "baseline":
+            continue
+        ok = r["stopped_unstable"] is None and all(v is not None and abs(v) < SAFE for v in changes[r["name"]][1].values())
+        knobs[r["knob"]] = knobs.get(r["knob"], True) and ok
+    return knobs
+
+
+def _f(value, fmt):
+    return "–" if value is None or (isinstance(value, float) and math.isnan(value)) else fmt % value
+
+
+def table(rows, machine):
+    """The Markdown section written between the PILE markers of doc/tradeoffs.md."""
+    changes = relative_changes(rows)
+    lines = ["Measured on %s by `bash scripts/tradeoffs-pile.sh`, one run each. The submerged, lidded pile on the laboratory head "
+             "history in a one-cell-wide flume (plane strain), semi-implicit, real water; one knob changed at a time around the quick "
+             "baseline (h = 2 cm, 2 points per cell, uGIMP, α = 100, T = 60 s). Onset: the slope face's compliance "
+             "(excess head over the still water, time after the rise began); Bishop: slides ≥ 3 cells deep on the run's own "
+             "pressures; Δ: change against the knob's reference (α = 1, h = 1 cm, 3 points per cell where run, else the baseline)." % machine,
+             "",
+             "| knob | setting | solid points | solver wall time [s] | onset excess head [mm] | Δ | onset time after rise [s] | Δ | Bishop onset excess head [mm] | face at end [mm] | Δ | toe at end [mm] | run-out [mm] | note |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    longest = max(r["simulated_time_s"] for r in rows)
+    for r in rows:
+        reference, c = changes[r["name"]]
+        note = []
+        if r["stopped_unstable"]:
+            note.append("stopped unstable")
+        if r["inertia_scale_release_time_s"] is not None:
+            note.append("α released at %.1f s" % r["inertia_scale_release_time_s"])
+        if r["simulated_time_s"] < 0.999 * longest:
+            note.append("ended at %.1f s" % r["simulated_time_s"])
+        if reference == r["name"]:
+            note.append("reference")
+        lines.append("| %s | %s | %d | %.0f | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            r["knob"].replace("_", " "), r["setting"], r["solid_points"], r["solver_time_s"],
+            _f(None if r["onset_excess_head_m"] is None else 1e3 * r["onset_excess_head_m"], "%.1f"), _f(None if reference == r["name"] else c["onset_excess_head_m"], "%+.3f"),
+            _f(r["onset_time_after_rise_s"], "%.1f"), _f(None if reference == r["name"] else c["onset_time_after_rise_s"], "%+.3f"),
+            _f(None if r["lem_deep_onset_excess_head_m"] is None else 1e3 * r["lem_deep_onset_excess_head_m"], "%.1f"),
+            _f(1e3 * r["face_displacement_end_m"], "%.2f"), _f(None if reference == r["name"] else c["face_displacement_end_m"], "%+.3f"),
+            _f(1e3 * r["toe_displacement_end_m"], "%.2f"), _f(None if r["runout_m"] is None else 1e3 * r["runout_m"], "%.1f"), "; ".join(note)))
+    knobs = safe_knobs(rows, changes)
+    safe = sorted(k.replace("_", " ") for k, ok in knobs.items() if ok)
+    unsafe = sorted(k.replace("_", " ") for k, ok in knobs.items() if not ok)
+    lines += ["", "Δ is relative (+0.050 = 5%% more). Within %d%% of the reference on all three answers (safe speed knobs): %s. "
+              "Changing the answer by more: %s." % (round(100 * SAFE), ", ".join(safe) or "none", ", ".join(unsafe) or "none"),
+              "", "![pile: answer against cost](figures/tradeoffs_pile.png)"]
+    return lines
+
+
+def figure(path, rows):
+    """Onset excess head and the face's displacement at the end against the solver's wall time, one
+    marker per run, labelled with its setting."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for r in rows:
+        t = r["solver_time_s"]
+        if r["onset_excess_head_m"] is not None:
+            left.plot(t, 1e3 * r["onset_excess_head_m"], "o", color="C0")
+            left.annotate(r["setting"], (t, 1e3 * r["onset_excess_head_m"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
+        right.plot(t, 1e3 * r["face_displacement_end_m"], "s", color="C1")
+        right.annotate(r["setting"], (t, 1e3 * r["face_displacement_end_m"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    for ax, label in ((left, "onset excess head [mm]"), (right, "slope face displacement at the end [mm]")):
+        ax.set_xscale("log")
+        ax.set_xlabel("solver wall time [s]")
+        ax.set_ylabel(label)
+    fig.suptitle("the submerged pile on the laboratory head history: answer against cost (one knob at a time)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return fig
+
+
+def write_section(doc_path, lines, marker="PILE"):
+    """Replace the text between <!-- marker --> and <!-- /marker --> in doc_path (appended with its
+    heading if the markers are not there yet)."""
+    text = open(doc_path).read() if os.path.exists(doc_path) else ""
+    block = "<!-- %s -->\n%s\n<!-- /%s -->" % (marker, "\n".join(lines), marker)
+    pattern = re.compile(r"<!-- %s -->.*<!-- /%s -->" % (marker, marker), re.S)
+    if pattern.search(text):
+        text = pattern.sub(lambda _: block, text)
+    else:
+        text = text.rstrip("\n") + "\n\n## The sand pile: cost knobs against its answer\n\n" + block + "\n"
+    with open(doc_path, "w") as f:
+        f.write(text)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--runs", required=True, help="directory of the runs and their index")
+    parser.add_argument("--machine", default="this machine", help="what ran them (cores, CPU, date)")
+    parser.add_argument("--doc", help="Markdown file whose PILE section is rewritten")
+    parser.add_argument("--figure", help="PNG of the answers against cost")
+    args = parser.parse_args(argv)
+    rows = collect(args.runs)
+    lines = table(rows, args.machine)
+    if args.doc:
+        write_section(args.doc, lines)
+    if args.figure:
+        figure(args.figure, rows)
+    with open(os.path.join(args.runs, "tradeoffs.json"), "w") as f:
+        json.dump({"rows": rows, "changes": relative_changes(rows)}, f, indent=1)
+    print("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
