@@ -7,8 +7,10 @@
 #   pile       examples/sandpile/sandpile.py, quick mode (h = 2 cm):
 #              - the main job's scene (yade_mpm.sandpile.DEFAULT, explicit): doc/figures/sandpile_quick_* (3 min)
 #              - the submerged pile on the laboratory head history (yade_mpm.sandpile.SUBMERGED, semi-implicit,
-#                α = 100, crest lid; doc/sandpile.md): doc/figures/sandpile_lab_quick_* (10 min)
-#              with --full also the main job's scene at h = 1 cm: doc/figures/sandpile_full_* (about 1 h)
+#                α = 100, crest lid; doc/sandpile.md) in a one-cell-wide flume (plane strain between its smooth
+#                walls; the quick pile moves within 1% of the 0.10 m flume's): h = 2 cm, doc/figures/sandpile_lab_quick_*
+#                (3 min), and h = 1 cm, doc/figures/sandpile_lab_full_* (17 min)
+#              with --full also the main job's scene at h = 1 cm: doc/figures/sandpile_full_* (about 30 min)
 # Each pile run's summary.json is copied next to its figures, so that doc/ states which run drew them.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -49,7 +51,9 @@ for part in "${parts[@]}"; do
     compare) "$root/scripts/compare.sh" ;;
     pile)
       run_pile quick --quick
-      run_pile lab_quick --quick --submerged --scheme semi-implicit --inertia-scale 100 --crest-lid --lid-friction 0.7
+      lab=(--submerged --scheme semi-implicit --inertia-scale 100 --crest-lid --lid-friction 0.7)
+      run_pile lab_quick --quick --flume-width 0.02 "${lab[@]}"
+      run_pile lab_full --cell 0.01 --flume-width 0.01 "${lab[@]}"
       [ "$full" = 0 ] || run_pile full
       ;;
   esac

@@ -40,6 +40,8 @@ for config in "${configs[@]}"; do
   fi
   echo "$name $knob $setting" >> "$runs/index.new"
 done
+# the baseline is also the setting of the knobs whose reference is another run
+printf "baseline inertia_scale α=100\nbaseline cell_size h=2cm\nbaseline points_per_cell 2\n" >> "$runs/index.new"
 mv "$runs/index.new" "$runs/index"
 machine="$(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(date -u +%Y-%m-%d)"
 PYTHONPATH="$build/python" /usr/bin/python3 -m yade_mpm.pile_tradeoffs --runs "$runs" --machine "$machine" \

@@ -8,12 +8,15 @@ from yade_mpm import pile_tradeoffs
 
 def _run(directory, onset_head, onset_time, face, solver_time, stopped=None, settle=1.0, still=0.15):
     directory.mkdir()
-    summary = {"scene": {"still_water_level": still, "settle_time": settle},
+    summary = {"scene": {"still_water_level": still, "settle_time": settle, "head_start": 0.15, "head_end": 0.27, "head_ramp_time": 60.0,
+                         "hold_time": 20.0},
                "onset": None if onset_head is None else {"head_m": onset_head, "time_s": onset_time},
                "lem_deep_onset_head_m": 0.227, "runout_m": 0.006, "simulated_time_s": 81.0, "solver_time_s": solver_time,
                "solid_points": 500, "inertia_scale_release_time_s": None, "stopped_unstable": stopped}
     (directory / "summary.json").write_text(json.dumps(summary))
-    (directory / "time_series.csv").write_text("time_s,face_displacement_m,toe_displacement_m\n1.0,0.0,0.0\n81.0,%r,0.004\n" % face)
+    # records every 1 s: the onset's resolution is 1 s and 2 mm of head (0.12 m over 60 s)
+    rows = ["%r,%r,%r" % (t, face * t / 81.0, 0.004 * t / 81.0) for t in range(1, 82)]
+    (directory / "time_series.csv").write_text("time_s,face_displacement_m,toe_displacement_m\n" + "\n".join(rows) + "\n")
 
 
 @pytest.fixture
@@ -33,25 +36,40 @@ def runs(tmp_path):
 def test_each_run_is_set_against_its_knobs_most_accurate_run(runs):
     rows = pile_tradeoffs.collect(runs)
     changes = pile_tradeoffs.relative_changes(rows)
+    names = [r["name"] for r in rows]
     assert rows[0]["onset_excess_head_m"] == pytest.approx(0.030) and rows[0]["onset_time_after_rise_s"] == pytest.approx(16.0)
-    reference, c = changes["baseline"]  # the baseline is an α = 100 run: not its own reference
-    assert reference == "baseline"
-    reference, c = changes["alpha10"]
+    assert rows[0]["record_interval_s"] == pytest.approx(1.0) and rows[0]["head_rate_m_per_s"] == pytest.approx(0.002)
+    assert changes[names.index("baseline")][0] == "baseline"
+    reference, c = changes[names.index("alpha10")]
     assert reference == "alpha1"
     assert c["onset_excess_head_m"] == pytest.approx((0.0303 - 0.0306) / 0.0306)
-    assert changes["full"][0] == "full" and changes["kwlow"][0] == "baseline"
-    assert changes["kwlow"][1]["onset_excess_head_m"] is None  # no onset: no change to state
+    assert changes[names.index("full")][0] == "full" and changes[names.index("kwlow")][0] == "baseline"
+    assert changes[names.index("kwlow")][1]["onset_excess_head_m"] is None  # no onset: no change to state
 
 
 def test_a_knob_is_safe_only_if_every_answer_of_every_run_stays_within_five_percent(runs):
+    """α = 10 is within 2% of α = 1 on every answer: safe; Kw/10 has no onset: not safe; the cell size
+    has only its reference run until the baseline is listed under it too (face 20 against 60 mm)."""
     rows = pile_tradeoffs.collect(runs)
     knobs = pile_tradeoffs.safe_knobs(rows, pile_tradeoffs.relative_changes(rows))
-    assert knobs == {"inertia_scale": True, "cell_size": True, "water_bulk_modulus": False}
-    # the cell size's only other run is its reference: nothing set against it here, so it reads safe;
-    # with the baseline listed under that knob too, it is not (face 20 against 60 mm)
+    assert knobs == {"inertia_scale": True, "water_bulk_modulus": False}
     (runs / "index").write_text((runs / "index").read_text() + "baseline cell_size h=2cm\n")
     rows = pile_tradeoffs.collect(runs)
     assert pile_tradeoffs.safe_knobs(rows, pile_tradeoffs.relative_changes(rows))["cell_size"] is False
+
+
+def test_an_onset_one_record_apart_is_the_same_onset(tmp_path):
+    """The onset is read at the records (1 s, 2 mm of head here): 1 mm of excess head is 3% of 30 mm
+    and 1 s of onset time 6% of 16 s — the second is more than 5% but within one record, so the same."""
+    _run(tmp_path / "baseline", 0.180, 17.0, 0.020, 150)
+    _run(tmp_path / "linear", 0.181, 18.0, 0.0201, 100)
+    (tmp_path / "index").write_text("baseline baseline quick\nlinear shape_function linear\n")
+    rows = pile_tradeoffs.collect(tmp_path)
+    assert pile_tradeoffs.safe_knobs(rows, pile_tradeoffs.relative_changes(rows)) == {"shape_function": True}
+    _run(tmp_path / "late", 0.186, 20.0, 0.0201, 100)  # 3 s later: three records
+    (tmp_path / "index").write_text("baseline baseline quick\nlate shape_function late\n")
+    rows = pile_tradeoffs.collect(tmp_path)
+    assert pile_tradeoffs.safe_knobs(rows, pile_tradeoffs.relative_changes(rows)) == {"shape_function": False}
 
 
 def test_the_section_between_the_markers_is_replaced_and_the_rest_kept(runs, tmp_path):
