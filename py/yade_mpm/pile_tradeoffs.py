@@ -102,16 +102,23 @@ def _within(r, reference, key, change):
 def safe_knobs(rows, changes):
     """Knobs whose every run stays within SAFE of its reference on every answer (the onset within one
     record); a run without an onset, or stopped as unstable, counts as a change."""
+    knobs = {}
+    for r, ok in same_answer(rows, changes):
+        knobs[r["knob"]] = knobs.get(r["knob"], True) and ok
+    return knobs
+
+
+def same_answer(rows, changes):
+    """(run, whether it gives its reference's answer) for every run set against another one."""
     by_name = {}
     for r in rows:
         by_name.setdefault(r["name"], r)
-    knobs = {}
+    out = []
     for r, (reference, change) in zip(rows, changes):
-        if r["knob"] == "baseline" or reference == r["name"]:
+        if r["knob"] == "baseline" or reference is None or reference == r["name"]:
             continue
-        ok = r["stopped_unstable"] is None and all(_within(r, by_name[reference], k, v) for k, v in change.items())
-        knobs[r["knob"]] = knobs.get(r["knob"], True) and ok
-    return knobs
+        out.append((r, r["stopped_unstable"] is None and all(_within(r, by_name[reference], k, v) for k, v in change.items())))
+    return out
 
 
 def _f(value, fmt):
@@ -147,12 +154,12 @@ def table(rows, machine):
             _f(None if r["face_at_end_of_rise_m"] is None else 1e3 * r["face_at_end_of_rise_m"], "%.2f"),
             _f(None if reference == r["name"] else c["face_at_end_of_rise_m"], "%+.3f"),
             _f(None if r["toe_at_end_of_rise_m"] is None else 1e3 * r["toe_at_end_of_rise_m"], "%.2f"), _f(None if r["runout_m"] is None else 1e3 * r["runout_m"], "%.1f"), "; ".join(note)))
-    knobs = safe_knobs(rows, changes)
-    safe = sorted(k.replace("_", " ") for k, ok in knobs.items() if ok)
-    unsafe = sorted(k.replace("_", " ") for k, ok in knobs.items() if not ok)
+    verdicts = same_answer(rows, changes)
+    safe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if ok]
+    unsafe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if not ok]
     lines += ["", "Δ is relative (+0.050 = 5%% more); the onset is read at the records, so it is resolved to one record interval "
               "(1.16 s and 2.3 mm of head on the 81 s history). Within %d%% of the reference on all three answers (the onset within "
-              "one record; safe speed knobs): %s. "
+              "one record; safe speed settings): %s. "
               "Changing the answer by more: %s." % (round(100 * SAFE), ", ".join(safe) or "none", ", ".join(unsafe) or "none"),
               "", "![pile: answer against cost](figures/tradeoffs_pile.png)"]
     return lines
