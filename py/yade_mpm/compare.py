@@ -289,8 +289,21 @@ def tradeoffs(out_dir, quick):
         lines.append("| %s | %s | %s | %d | %d | %.2f | %.3g | %.4f | %.4f |" % (r["method"], r["knob"], r["setting"], r["bodies"], r["steps"], r["wall_time"],
                                                                           r["per_simulated_second"], r["pressure_error"], r["degree_error"]))
     lines += ["", "![error against cost](figures/tradeoffs.png)", ""]
-    with open(os.path.join(out_dir, "tradeoffs.md"), "w") as f:
-        f.write("\n".join(lines))
+    write_tradeoffs_doc(os.path.join(out_dir, "tradeoffs.md"), lines)
+
+
+def write_tradeoffs_doc(path, lines):
+    """Write the oedometer's study to `path`, keeping the sand pile's section that
+    scripts/tradeoffs-pile.sh writes there (yade_mpm.pile_tradeoffs) as it is."""
+    from . import pile_tradeoffs
+    kept = ""
+    if os.path.exists(path):
+        with open(path) as f:
+            old = f.read()
+        if pile_tradeoffs.HEADING in old:
+            kept = "\n" + old[old.index(pile_tradeoffs.HEADING):]
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + kept)
 
 
 def _tradeoff_figure(path, rows):

@@ -21,6 +21,7 @@ import numpy as np
 
 from .compare_pile import read_run
 
+HEADING = "## The sand pile: cost knobs against its answer"  # its section of doc/tradeoffs.md (yade_mpm.compare keeps it)
 SAFE = 0.05  # relative change of every answer that still counts as "the same" [-]
 MOST_ACCURATE = {"inertia_scale": "alpha1", "cell_size": "full", "points_per_cell": "ppc3"}  # knob → reference run (else the baseline)
 
@@ -200,7 +201,7 @@ def write_section(doc_path, lines, marker="PILE"):
     if pattern.search(text):
         text = pattern.sub(lambda _: block, text)
     else:
-        text = text.rstrip("\n") + "\n\n## The sand pile: cost knobs against its answer\n\n" + block + "\n"
+        text = text.rstrip("\n") + "\n\n" + HEADING + "\n\n" + block + "\n"
     with open(doc_path, "w") as f:
         f.write(text)
 

@@ -82,3 +82,17 @@ def test_the_section_between_the_markers_is_replaced_and_the_rest_kept(runs, tmp
     assert text.startswith("# Speed for accuracy\n\nthe oedometer table\n")
     assert text.count("<!-- PILE -->") == 1 and "again\n<!-- /PILE -->" in text
     assert "| inertia scale | α=10 | 500 | 450 | 30.3 | -0.010 |" in text
+
+
+def test_the_oedometer_study_rewrites_its_part_and_keeps_the_piles(runs, tmp_path):
+    """yade_mpm.compare rewrites doc/tradeoffs.md from its own rows: the pile's section, written by
+    another script, must survive it unchanged."""
+    from yade_mpm import compare
+    doc = tmp_path / "tradeoffs.md"
+    compare.write_tradeoffs_doc(doc, ["# Speed for accuracy", "", "old oedometer table", ""])
+    pile_tradeoffs.write_section(doc, pile_tradeoffs.table(pile_tradeoffs.collect(runs), "test machine"))
+    pile_part = doc.read_text()[doc.read_text().index(pile_tradeoffs.HEADING):]
+    compare.write_tradeoffs_doc(doc, ["# Speed for accuracy", "", "new oedometer table", ""])
+    text = doc.read_text()
+    assert "new oedometer table" in text and "old oedometer table" not in text
+    assert text.endswith(pile_part) and text.count(pile_tradeoffs.HEADING) == 1
