@@ -168,19 +168,23 @@ def table(rows, machine):
 
 def figure(path, rows):
     """Onset excess head and the face's displacement at the full head against the solver's wall time, one
-    marker per run, labelled with its setting."""
+    marker per run, labelled with its setting (hollow: the run stopped as unstable)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for r in rows:
-        t = r["solver_time_s"]
+    seen = set()
+    for r in rows:  # each run once (the baseline is listed under several knobs); hollow: stopped as unstable
+        if r["name"] in seen:
+            continue
+        seen.add(r["name"])
+        t, label, face = r["solver_time_s"], "baseline" if r["knob"] == "baseline" else r["setting"], "none" if r["stopped_unstable"] else None
         if r["onset_excess_head_m"] is not None:
-            left.plot(t, 1e3 * r["onset_excess_head_m"], "o", color="C0")
-            left.annotate(r["setting"], (t, 1e3 * r["onset_excess_head_m"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
+            left.plot(t, 1e3 * r["onset_excess_head_m"], "o", color="C0", mfc=face)
+            left.annotate(label, (t, 1e3 * r["onset_excess_head_m"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
         if r["face_at_end_of_rise_m"] is not None:
-            right.plot(t, 1e3 * r["face_at_end_of_rise_m"], "s", color="C1")
-            right.annotate(r["setting"], (t, 1e3 * r["face_at_end_of_rise_m"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
+            right.plot(t, 1e3 * r["face_at_end_of_rise_m"], "s", color="C1", mfc=face)
+            right.annotate(label, (t, 1e3 * r["face_at_end_of_rise_m"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
     for ax, label in ((left, "onset excess head [mm]"), (right, "slope face displacement at the full head [mm]")):
         ax.set_xscale("log")
         ax.set_xlabel("solver wall time [s]")
