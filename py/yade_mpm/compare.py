@@ -276,7 +276,7 @@ def tradeoffs(out_dir, quick):
     with open(os.path.join(out_dir, "figures", "tradeoffs.json"), "w") as f:
         json.dump({"quick": quick, "time_factors": TIME_FACTORS, "depths": DEPTHS, "rows": rows}, f, indent=1)
     _tradeoff_figure(os.path.join(out_dir, "figures", "tradeoffs.png"), rows)
-    lines = ["# Speed for accuracy: the oedometer, DEM + PFV and MPM" + (" (quick)" if quick else ""), "",
+    lines = ["# Speed for accuracy: the oedometer (DEM + PFV and MPM) and the sand pile" + (" (quick)" if quick else ""), "",
              "Written by `python3 -m yade_mpm.compare tradeoffs%s`: each model against Terzaghi's series at Tv = %s, probes at ζ = %s"
              % (" --quick" if quick else "", ", ".join("%g" % t for t in TIME_FACTORS), ", ".join("%.1f" % z for z in DEPTHS)),
              "(max |p − p_T|/q over them), and U from the settlement (max |U − U_T|). The MPM runs on the material measured on the %d-grain"
