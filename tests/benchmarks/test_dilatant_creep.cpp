@@ -12,9 +12,10 @@
 // acceleration), and not at all without dilatancy. This is the rate limit Iverson et al. (2000,
 // "Acute sensitivity of landslide rates to initial soil porosity", Science 290, 513–516) measured in
 // a flume: under slowly rising pore pressure their sandy soil at n ≈ 0.4 dilated and slipped
-// episodically at about 0.002 m/s, the same soil at n ≈ 0.5 contracted and ran away at > 1 m/s. It is
-// also why inertial mass scaling (eq. 4.8b) is admissible for a dense sand's creep: its rate is set
-// by the drag, not by the inertia.
+// episodically at about 0.002 m/s, the same soil at n ≈ 0.5 contracted and ran away at > 1 m/s. A
+// steady creep's rate is set by the drag, not by the inertia, so inertial mass scaling (eq. 4.8b)
+// leaves it alone (the sand pile's response to its rising head is not such a creep: there α changes
+// the answer, doc/tradeoffs.md).
 #include "core/TwoPhaseSolver.hpp"
 #include "support/Fixtures.hpp"
 
