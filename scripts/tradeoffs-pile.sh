@@ -17,20 +17,21 @@ build="${MPM_BUILD_DIR:-$root/build}"
 runs="${PILE_TRADEOFF_RUNS:-$(mktemp -d)}"
 mkdir -p "$runs"
 base=(--submerged --scheme semi-implicit --crest-lid --lid-friction 0.7)
-#      name         knob               setting      arguments beyond the baseline's
+# "reference" marks a knob's most accurate setting, which its other runs are set against (else the baseline)
+#      name         knob               setting  role       arguments beyond the baseline's
 configs=(
-  "baseline     baseline           quick        --quick --flume-width 0.02 --inertia-scale 100"
-  "ramp2T       ramp_time          2T           --quick --flume-width 0.02 --inertia-scale 100 --ramp-time 120"
-  "alpha10      inertia_scale      α=10         --quick --flume-width 0.02 --inertia-scale 10"
-  "full         cell_size          h=1cm        --cell 0.01 --flume-width 0.01 --inertia-scale 100"
-  "linear       shape_function     linear       --quick --flume-width 0.02 --inertia-scale 100 --shape-function linear"
-  "cpgimp       shape_function     cpGIMP       --quick --flume-width 0.02 --inertia-scale 100 --shape-function cpGIMP"
-  "ppc3         points_per_cell    3            --quick --flume-width 0.02 --inertia-scale 100 --points-per-cell 3"
-  "kwlow        water_bulk_modulus Kw/10        --quick --flume-width 0.02 --inertia-scale 100 --water-bulk-modulus 2.2e8"
-  "alpha1       inertia_scale      α=1          --quick --flume-width 0.02 --inertia-scale 1"
+  "baseline     baseline           quick    -          --quick --flume-width 0.02 --inertia-scale 100"
+  "ramp2T       ramp_time          2T       -          --quick --flume-width 0.02 --inertia-scale 100 --ramp-time 120"
+  "alpha10      inertia_scale      α=10     -          --quick --flume-width 0.02 --inertia-scale 10"
+  "full         cell_size          h=1cm    reference  --cell 0.01 --flume-width 0.01 --inertia-scale 100"
+  "linear       shape_function     linear   -          --quick --flume-width 0.02 --inertia-scale 100 --shape-function linear"
+  "cpgimp       shape_function     cpGIMP   -          --quick --flume-width 0.02 --inertia-scale 100 --shape-function cpGIMP"
+  "ppc3         points_per_cell    3        reference  --quick --flume-width 0.02 --inertia-scale 100 --points-per-cell 3"
+  "kwlow        water_bulk_modulus Kw/10    -          --quick --flume-width 0.02 --inertia-scale 100 --water-bulk-modulus 2.2e8"
+  "alpha1       inertia_scale      α=1      reference  --quick --flume-width 0.02 --inertia-scale 1"
 )
 for config in "${configs[@]}"; do
-  read -r name knob setting extra <<< "$config"
+  read -r name knob setting role extra <<< "$config"
   out="$runs/$name"
   if [ ! -f "$out/summary.json" ]; then
     echo "== $name: examples/sandpile/sandpile.py ${base[*]} $extra"
@@ -38,7 +39,7 @@ for config in "${configs[@]}"; do
     PYTHONPATH="$build/python" HOME="$runs" yade-double -j2 -n -x "$root/examples/sandpile/sandpile.py" "${base[@]}" $extra --out "$out" \
       > "$runs/$name.log" 2>&1 || { tail -30 "$runs/$name.log"; exit 1; }
   fi
-  echo "$name $knob $setting" >> "$runs/index.new"
+  echo "$name $knob $setting $([ "$role" = reference ] && echo reference)" >> "$runs/index.new"
 done
 # the baseline is also the setting of the knobs whose reference is another run
 printf "baseline inertia_scale α=100\nbaseline cell_size h=2cm\nbaseline points_per_cell 2\n" >> "$runs/index.new"

@@ -3,12 +3,13 @@
     python3 -m yade_mpm.pile_tradeoffs --runs DIR [--machine TEXT] [--doc doc/tradeoffs.md] [--figure PNG]
 
 DIR holds runs of examples/sandpile/sandpile.py (each a directory with summary.json and time_series.csv)
-and an `index` file, a line per run: `name knob setting` (scripts/tradeoffs-pile.sh writes both). Each
-knob's runs are set against its reference run — the most accurate setting where there is one (α = 1,
-the finer cell, more points per cell), else the baseline — on three answers: the excess head over the
-still water at the onset (the slope face's compliance, yade_mpm.analysis.compliance_onset), the onset's
-time after the rise began, and the slope face's displacement when the head reaches its end; a knob whose every run stays
-within `SAFE` of its reference on all three is a safe speed knob.
+and an `index` file, a line per run: `name knob setting [reference]` (scripts/tradeoffs-pile.sh writes
+both). Each knob's runs are set against its run marked `reference` — the most accurate setting where
+there is one (α = 1, the finer cell, more points per cell) — or else against the run named `baseline`,
+on three answers: the excess head over the still water at the onset (the slope face's compliance,
+yade_mpm.analysis.compliance_onset), the onset's time after the rise began, and the slope face's
+displacement when the head reaches its end; a setting within `SAFE` of its reference on all three (the
+onset within one record, its resolution) is a safe speed setting.
 """
 import argparse
 import json
@@ -23,7 +24,6 @@ from .compare_pile import read_run
 
 HEADING = "## The sand pile: cost knobs against its answer"  # its section of doc/tradeoffs.md (yade_mpm.compare keeps it)
 SAFE = 0.05  # relative change of every answer that still counts as "the same" [-]
-MOST_ACCURATE = {"inertia_scale": "alpha1", "cell_size": "full", "points_per_cell": "ppc3"}  # knob → reference run (else the baseline)
 
 
 def _at(columns, key, time):
@@ -41,14 +41,18 @@ def collect(runs_dir):
         for line in f.read().splitlines():
             if not line.strip():
                 continue
-            name, knob, setting = line.split()[:3]
+            fields = line.split()
+            name, knob, setting = fields[:3]
             summary, columns = read_run(os.path.join(runs_dir, name))
             scene = summary["scene"]
             still = scene["still_water_level"] if scene.get("still_water_level") is not None else 0.0
             onset = summary.get("onset")
             rise_end = scene["settle_time"] + scene["head_ramp_time"]  # every run is compared at its full head
             rows.append({
-                "name": name, "knob": knob, "setting": setting,
+                "name": name, "knob": knob, "setting": setting, "reference": fields[3:4] == ["reference"],
+                "cell_size_m": summary["cell_size_m"], "points_per_cell": summary.get("points_per_cell"),
+                "shape_function": summary.get("shape_function"), "inertia_scale": summary["inertia_scale"],
+                "flume_width_m": scene["flume_width"], "ramp_time_s": scene["head_ramp_time"], "scheme": summary["scheme"],
                 "onset_excess_head_m": None if onset is None else onset["head_m"] - still,
                 "onset_time_after_rise_s": None if onset is None else onset["time_s"] - scene["settle_time"],
                 "lem_deep_onset_excess_head_m": None if summary.get("lem_deep_onset_head_m") is None else summary["lem_deep_onset_head_m"] - still,
@@ -74,12 +78,11 @@ ANSWERS = ("onset_excess_head_m", "onset_time_after_rise_s", "face_at_end_of_ris
 def relative_changes(rows):
     """Per run (a list in the order of `rows`): its knob's reference run's name and the relative
     change of each answer against it (None where an answer or the reference is missing)."""
-    by_name = {}
-    for r in rows:
-        by_name.setdefault(r["name"], r)
+    baseline = next((r for r in rows if r["name"] == "baseline"), None)
+    marked = {r["knob"]: r for r in rows if r["reference"]}
     out = []
     for r in rows:
-        reference = by_name.get(MOST_ACCURATE.get(r["knob"], "baseline"), by_name.get("baseline"))
+        reference = marked.get(r["knob"], baseline)
         changes = {}
         for key in ANSWERS:
             a, b = r[key], None if reference is None else reference[key]
@@ -98,15 +101,6 @@ def _within(r, reference, key, change):
     step = {"onset_time_after_rise_s": lambda x: x["record_interval_s"],
             "onset_excess_head_m": lambda x: x["record_interval_s"] * x["head_rate_m_per_s"]}.get(key)
     return step is not None and abs(r[key] - reference[key]) <= max(step(r), step(reference)) * (1 + 1e-9)
-
-
-def safe_knobs(rows, changes):
-    """Knobs whose every run stays within SAFE of its reference on every answer (the onset within one
-    record); a run without an onset, or stopped as unstable, counts as a change."""
-    knobs = {}
-    for r, ok in same_answer(rows, changes):
-        knobs[r["knob"]] = knobs.get(r["knob"], True) and ok
-    return knobs
 
 
 def same_answer(rows, changes):
@@ -129,11 +123,14 @@ def _f(value, fmt):
 def table(rows, machine):
     """The Markdown section written between the PILE markers of doc/tradeoffs.md."""
     changes = relative_changes(rows)
+    base = next((r for r in rows if r["name"] == "baseline"), rows[0])
     lines = ["Measured on %s by `bash scripts/tradeoffs-pile.sh`, one run each. The submerged, lidded pile on the laboratory head "
-             "history in a one-cell-wide flume (plane strain), semi-implicit, real water; one knob changed at a time around the quick "
-             "baseline (h = 2 cm, 2 points per cell, uGIMP, α = 100, T = 60 s). Onset: the slope face's compliance "
+             "history in a flume %.3g m wide (smooth walls: plane strain), %s; one knob changed at a time around the baseline (h = %.3g m, "
+             "%s points per cell, %s, α = %g, T = %.0f s). Onset: the slope face's compliance "
              "(excess head over the still water, time after the rise began); Bishop: slides ≥ 3 cells deep on the run's own "
-             "pressures; Δ: change against the knob's reference (α = 1, h = 1 cm, 3 points per cell where run, else the baseline)." % machine,
+             "pressures; Δ: change against the knob's reference run (its most accurate setting where run, else the baseline)."
+             % (machine, base["flume_width_m"], base["scheme"], base["cell_size_m"], base["points_per_cell"] or "–", base["shape_function"] or "–",
+                base["inertia_scale"], base["ramp_time_s"]),
              "",
              "| knob | setting | solid points | solver wall time [s] | onset excess head [mm] | Δ | onset time after rise [s] | Δ | Bishop onset excess head [mm] | face at full head [mm] | Δ | toe at full head [mm] | run-out at the end [mm] | note |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -159,9 +156,10 @@ def table(rows, machine):
     safe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if ok]
     unsafe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if not ok]
     lines += ["", "Δ is relative (+0.050 = 5%% more); the onset is read at the records, so it is resolved to one record interval "
-              "(1.16 s and 2.3 mm of head on the 81 s history). Within %d%% of the reference on all three answers (the onset within "
+              "(%.2f s and %.1f mm of head in the baseline). Within %d%% of the reference on all three answers (the onset within "
               "one record; safe speed settings): %s. "
-              "Changing the answer by more: %s." % (round(100 * SAFE), ", ".join(safe) or "none", ", ".join(unsafe) or "none"),
+              "Changing the answer by more: %s." % (base["record_interval_s"], 1e3 * base["record_interval_s"] * base["head_rate_m_per_s"],
+                                                    round(100 * SAFE), ", ".join(safe) or "none", ", ".join(unsafe) or "none"),
               "", "![pile: answer against cost](figures/tradeoffs_pile.png)"]
     return lines
 
