@@ -150,7 +150,9 @@ def time_series(path, series, lem=None, failure_displacement=None, failure_time=
     water.legend(fontsize=7)
     if lem is not None:
         lem_times, factors = lem
-        for (label, values), style in zip(factors.items(), ("o-", "s--", "^:", "d-.")):
+        styles = ("o-", "s--", "^:", "d-.")
+        for i, (label, values) in enumerate(factors.items()):
+            style = styles[i % len(styles)]
             values = np.array([np.nan if v is None else v for v in values], dtype=float)
             safety.plot(lem_times, values, style, label=label)
         safety.legend(fontsize=7)
