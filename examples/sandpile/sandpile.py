@@ -70,6 +70,7 @@ parser.add_argument("--inertia-release", type=float, default=0.1,
                     help="release threshold ε of the inertia scaling (engine inertiaScaleRelease, theory.md eq. 4.8c): the skeleton's "
                          "net inertial force over its weight; a slide of a fraction f of the pile shows as about f × its imbalance")
 parser.add_argument("--ramp-time", type=float, help="duration of the head rise [s] (default the scene's 0.3 s)")
+parser.add_argument("--settle-time", type=float, help="time at the starting head before the rise [s] (default the scene's 0.05 s)")
 parser.add_argument("--hold-time", type=float, help="head held at the crest after the rise [s] (default the scene's 0.35 s)")
 parser.add_argument("--submerged", action="store_true",
                     help="the pile under still water (yade_mpm.sandpile.SUBMERGED: excess pore pressure, theory.md eq. 1.9; "
@@ -92,6 +93,10 @@ parser.add_argument("--flume-width", type=float, metavar="W",
                     help="distance between the front and rear walls [m], a whole number of cells (default the scene's 0.10 m); with smooth "
                          "walls the pile is in plane strain, so a one-cell-wide flume gives the same answer at a fraction of the cost "
                          "(the laboratory history, quick: face and toe within 1%% of the 0.10 m flume's)")
+parser.add_argument("--capillary-surface", action="store_true",
+                    help="semi-implicit only: the sand above the water table starts saturated in suction and its surface holds it as "
+                         "capillary menisci do, a seepage face only where it would hold p > 0 (MpmTwoPhaseEngine.capillarySurface, "
+                         "theory.md eq. 8.5e); without it the semi-implicit pile is dry above the table")
 parser.add_argument("--points-per-cell", type=int, default=2, metavar="N", help="points per cell and axis of each phase (default 2)")
 parser.add_argument("--shape-function", choices=("linear", "uGIMP", "cpGIMP"), default="uGIMP", help="the engine's shape functions (default uGIMP)")
 parser.add_argument("--sand-from-dem", metavar="DIR",
@@ -115,8 +120,9 @@ if SUBMERGED and args.scheme != "semi-implicit":
     raise ValueError("--submerged runs on --scheme semi-implicit (got %r)" % args.scheme)
 if args.crest_lid:
     SCENE = dataclasses.replace(SCENE, crest_lid=True)
-if args.ramp_time is not None or args.hold_time is not None or args.head_start is not None or args.head_end is not None:
+if args.ramp_time is not None or args.hold_time is not None or args.head_start is not None or args.head_end is not None or args.settle_time is not None:
     SCENE = dataclasses.replace(SCENE, head_ramp_time=SCENE.head_ramp_time if args.ramp_time is None else args.ramp_time,
+                                settle_time=SCENE.settle_time if args.settle_time is None else args.settle_time,
                                 hold_time=SCENE.hold_time if args.hold_time is None else args.hold_time,
                                 head_start=SCENE.head_start if args.head_start is None else args.head_start,
                                 head_end=SCENE.head_end if args.head_end is None else args.head_end)
@@ -136,6 +142,11 @@ if args.sand_from_dem is not None:
 elif args.dem_strength_only:
     raise SystemExit("--dem-strength-only needs --sand-from-dem DIR (there is no DEM sand to take the strength from)")
 SEMI_IMPLICIT = args.scheme == "semi-implicit"
+if args.capillary_surface and not SEMI_IMPLICIT:
+    raise SystemExit("--capillary-surface needs --scheme semi-implicit (the explicit scheme's surface holds suction by freeSurfaceHoldsSuction)")
+# the sand above the table is saturated in suction where a surface holds it (explicit, or semi-implicit with the
+# capillary surface), else dry
+SUCTION_ABOVE_TABLE = not SEMI_IMPLICIT or args.capillary_surface
 GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
 G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]
 CELL = args.cell or (0.02 if args.quick else 0.01)  # h [m]
@@ -162,6 +173,8 @@ if not DURATION > 0:
 if not args.inertia_scale >= 1:
     raise ValueError("--inertia-scale = %r is outside the valid range [1, inf)" % args.inertia_scale)
 SCENE.validate()
+if not SCENE.settle_time >= 0:
+    raise ValueError("--settle-time = %r s is outside the valid range [0, inf)" % SCENE.settle_time)
 if not (SCENE.head_ramp_time > 0 and SCENE.hold_time >= 0):
     raise ValueError("--ramp-time = %r s and --hold-time = %r s must lie in (0, inf) and [0, inf)" % (SCENE.head_ramp_time, SCENE.hold_time))
 # Inertia scaling keeps drainage real only while the scaled time in which drag relaxes the water's
@@ -189,11 +202,9 @@ positions, spacing = sandpile.pile_points(SCENE, CELL, points_per_cell=args.poin
 solid_body, water_body = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=GRAVITY,
                                                    surface=SCENE.surface_height(positions[:, 0]),
                                                    lateral_earth_pressure=1 - math.sin(SCENE.friction_angle),
-                                                   # the explicit scheme's surface holds the suction; the semi-implicit one has
-                                                   # no capillary face yet, so there the sand above the table is dry
                                                    **(dict(still_water_level=SCENE.still_water_level) if SUBMERGED else
-                                                      dict(water_table=SCENE.head_start, suction_above_table=not SEMI_IMPLICIT,
-                                                           dry_above_table=SEMI_IMPLICIT)))
+                                                      dict(water_table=SCENE.head_start, suction_above_table=SUCTION_ABOVE_TABLE,
+                                                           dry_above_table=not SUCTION_ABOVE_TABLE)))
 O.bodies.append([solid_body, water_body])
 solid, fluid = solid_body.shape, water_body.shape
 start_positions = solid.pos.copy()
@@ -222,6 +233,7 @@ engine = MpmTwoPhaseEngine(
     drainedWaterTable=(SCENE.head_start, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE),
     freeSurfaceThreshold=0.75,  # the outer point layer is the pile's surface ...
     freeSurfaceHoldsSuction=not SEMI_IMPLICIT,  # ... held by capillarity above the phreatic line, a seepage face below it
+    capillarySurface=args.capillary_surface,    # the same on the semi-implicit step (theory.md eq. 8.5e)
     removeFreeWater=True)       # the filtering cloth
 recorder = MpmHdf5Recorder(label="recorder", file=os.path.join(OUT, "sandpile.h5"), iterPeriod=1)
 O.engines = [engine, recorder, yade_mpm.progress(seconds=60)]  # a progress line with an ETA every minute
@@ -424,6 +436,7 @@ summary = {
     "points_per_phase_initial": int(len(positions)),
     "points_per_cell": args.points_per_cell,
     "shape_function": args.shape_function,
+    "capillary_surface": args.capillary_surface,
     "solid_points": int(solid.count),
     "water_points_end": int(fluid.count),
     "scene": {k: getattr(SCENE, k) for k in SCENE.__dataclass_fields__},

@@ -324,6 +324,7 @@ namespace stages {
 			}
 		}
 		tieSurfaceNodes(grid, fields, sets, waterDensity, surface, system);
+		system.surface = surface;
 	}
 
 	template <class Kernel>
@@ -820,6 +821,90 @@ namespace stages {
 	}
 
 	template <class Kernel>
+	void meniscusTerms(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                   const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
+	                   Real waterMassTolerance, const std::vector<char>& candidate, PressureSystem& system, std::vector<MeniscusEntry>& entries)
+	{
+		entries.clear();
+		const std::size_t nodes = grid.nodeCount(), active = system.node.size();
+		const std::vector<Real> unit(nodes, 1);
+		accumulatePressureForces<Kernel>(grid, fields, solids, sets, unit, false, system);
+		std::vector<Vec3> area(nodes, Vec3::Zero());
+		std::vector<int>  slotOf(nodes, -1);
+		std::vector<std::size_t> candidates;
+		for (std::size_t r = 0; r < active; ++r)
+			if (candidate[r]) {
+				const std::size_t I = system.node[r];
+				slotOf[I]           = static_cast<int>(candidates.size());
+				candidates.push_back(r);
+				area[I] = system.forces[I].solid + system.forces[I].water;
+			}
+		for (std::size_t I = 0; I < nodes; ++I) system.forces[I] = PressureForceNode { slotOf[I] >= 0 ? area[I] : Vec3::Zero(), Vec3::Zero() };
+		std::vector<Vec3> us(candidates.size(), Vec3::Zero()), uw(candidates.size(), Vec3::Zero());
+		std::vector<Real> diagonal(candidates.size(), 0);
+		forEachPressureIncrement(fields, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, system,
+		                         [&](std::size_t i, const Vec3& ds, const Vec3& dw, const std::array<bool, 3>& mixture) {
+			if (slotOf[i] < 0) return;
+			const int c = slotOf[i];
+			for (int d = 0; d < 3; ++d) {
+				us[c][d] = mixture[d] ? ds[d] + dw[d] : ds[d];
+				uw[c][d] = mixture[d] ? ds[d] + dw[d] : dw[d];
+			}
+			diagonal[c] = area[i].dot(us[c]);
+		});
+		std::vector<std::array<Real, 125>> cross(candidates.size());
+		for (auto& a : cross) a.fill(0);
+		constexpr int S = Kernel::stencil;
+		for (const WaterPointSet* set : sets) {
+			const WaterPointSet& P = *set;
+			for (std::size_t p = 0; p < P.size(); ++p) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P, p, w);
+				std::size_t I[S * S * S];
+				Real        N[S * S * S];
+				Vec3        dN[S * S * S];
+				int         m = 0;
+				bool        touches = false;
+				Real        n = 0;
+				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real NJ, const Vec3& dNJ) {
+					I[m] = J, N[m] = NJ, dN[m] = dNJ, ++m;
+					n += NJ * fields.porosity[J];
+					touches = touches || (slotOf[J] >= 0 && NJ > 0);
+				});
+				if (!touches) continue;
+				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
+				const Real V = P.volume[p];
+				for (int a = 0; a < m; ++a) {
+					if (slotOf[I[a]] < 0 || N[a] == 0) continue;
+					const int                c  = slotOf[I[a]];
+					const std::array<int, 3> ia = grid.indices(I[a]);
+					for (int b = 0; b < m; ++b) {
+						const std::array<int, 3> ib = grid.indices(I[b]);
+						const int dx = ib[0] - ia[0], dy = ib[1] - ia[1], dz = ib[2] - ia[2];
+						if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap: not supported here
+						cross[c][offsetSlot(dx, dy, dz)] -= V * N[a] * ((1 - n) * dN[b].dot(us[c]) + n * dN[b].dot(uw[c]));
+					}
+				}
+			}
+		}
+		for (std::size_t c = 0; c < candidates.size(); ++c) {
+			const std::size_t        r   = candidates[c];
+			const std::array<int, 3> idx = grid.indices(system.node[r]);
+			for (int o = 0; o < PressureSystem::offsets; ++o) {
+				Real value = cross[c][o];
+				if (o == centreSlot) value = diagonal[c] + 2 * value;
+				if (value == 0) continue;
+				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, cc = o / 25 - 2;
+				if (o >= centreSlot) entries.push_back(MeniscusEntry { r, r, o - centreSlot, value });
+				else {
+					const int K = system.row[grid.index(idx[0] + a, idx[1] + b, idx[2] + cc)];
+					if (K >= 0) entries.push_back(MeniscusEntry { r, static_cast<std::size_t>(K), upperSlot(-a, -b, -cc), value });
+				}
+			}
+		}
+	}
+
+	template <class Kernel>
 	ProjectionForms projectionForms(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
 	                                const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
 	                                Real waterMassTolerance, const std::vector<Real>& freePressures, PressureSystem& system)
@@ -999,6 +1084,9 @@ namespace stages {
 	                                                     std::vector<WaterPointSet*>&, const BoundaryConditions&, const Vec3&, const WaterParameters&, \
 	                                                     const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, const PlateMotion*, Real, Real, \
 	                                                     Real, Real, int, PressureSystem&);                                                          \
+	template void meniscusTerms<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&,                \
+	                               const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real, const std::vector<char>&,      \
+	                               PressureSystem&, std::vector<MeniscusEntry>&);                                                                     \
 	template ProjectionForms projectionForms<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&, \
 	                                            const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,                \
 	                                            const std::vector<Real>&, PressureSystem&);                                                          \

@@ -75,6 +75,7 @@ struct PressureSystem {
 	std::vector<Real>        ghostFactor;    // per pressure node: c of p = c p_master (eq. 8.5b) [-]
 	std::vector<int>         tiedUnknown;    // per pressure node: the unknown its pressure is (free), or follows (tied), −1: prescribed
 	std::vector<Real>        tiedWeight;     // per pressure node: 1 (free) or c (tied) [-]
+	std::vector<char>        surface;        // per pressure node: on the free surface by its filling (classifyPressureNodes), not by a wall
 	std::vector<Real>        rows;           // per pressure node: rowStride values (K's upper half [m³ s⁻¹ Pa⁻¹], then b [m³ s⁻¹])
 	std::vector<std::vector<Real>> rowBuffers; // per extra thread
 	std::vector<Real>        nodalPressure;   // per grid node: p^{n+1}, 0 off the pressure nodes [Pa]
@@ -132,6 +133,21 @@ namespace stages {
 	void assemblePressureSystem(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, const std::vector<WaterPointSet*>& sets,
 	                            const WaterParameters& water, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
 	                            Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system);
+
+	// One addition to K's stored upper half: row r's slot (PressureSystem::rows), owned by the held
+	// surface node `owner` (a pressure node) whose meniscus term it belongs to (eq. 8.5e).
+	struct MeniscusEntry {
+		std::size_t owner, row;
+		int         slot;
+		Real        value;
+	};
+	// Eq. 8.5e's surface terms of the candidates (pressure nodes with `candidate` set): the meniscus
+	// force a_I q_I on the grains (a_I = Σ_p V ∇S_I for a unit pressure) coupled to the compact
+	// operator's gradient forms, Δt [ΣᵀM⁻¹Σ + GᵀM⁻¹Σ + ΣᵀM⁻¹G] with Σ lumped at node I.
+	template <class Kernel>
+	void meniscusTerms(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                   const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
+	                   Real waterMassTolerance, const std::vector<char>& candidate, PressureSystem& system, std::vector<MeniscusEntry>& entries);
 
 	// The rigid plate's column of B (theory.md eq. 2.9): b_J = Σ_wp V n D S_J + Σ_sp V (1 − n) D S_J with
 	// D = Σ_{I ∈ plate} ∂S_I/∂x_axis at the point, and c = Δt/M; K of eq. 8.7 gains c b bᵀ.

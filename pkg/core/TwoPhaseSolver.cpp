@@ -125,6 +125,8 @@ void SolverSettings::validate() const
 	// the semi-implicit one is stable without them (theory.md §8.4)
 	if (scheme == TimeScheme::SemiImplicit && pressureModeDamping)
 		throw InvalidParameter("pressureModeDamping = True is a relaxation of the explicit scheme (theory.md eq. 4.17b): it needs scheme = 'explicit'");
+	if (scheme == TimeScheme::Explicit && capillarySurface)
+		throw InvalidParameter("capillarySurface = True belongs to the semi-implicit scheme (theory.md eq. 8.5e): it needs scheme = 'semi-implicit' (the explicit scheme has freeSurfaceHoldsSuction)");
 	if (scheme == TimeScheme::SemiImplicit && freeSurfaceHoldsSuction)
 		throw InvalidParameter("freeSurfaceHoldsSuction = True belongs to the explicit scheme (theory.md eq. 2.3b): it needs scheme = 'explicit'");
 }
@@ -520,6 +522,60 @@ void TwoPhaseSolver::integrateMomentum(Real dt, bool wet, bool semiImplicit)
 	if (!constrained_.plate.empty()) moveRigidPlate(fields_, constrained_, dt, solidMassTolerance_, waterMassTolerance_, plate_); // eq. 2.9
 }
 
+// Eq. 8.5e: the soil's surface nodes hold suction (free, with the meniscus term on K's diagonal) until
+// the solve gives one of them p > 0; those become seepage-face nodes (p = 0, or tied as eq. 8.5b) and the
+// system is solved again, until no held node is positive.
+template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt)
+{
+	using namespace stages;
+	PressureSystem& sys = pressureSystem_;
+	const std::size_t active = sys.node.size();
+	std::vector<char> held(active, 0);
+	for (std::size_t r = 0; r < active; ++r) held[r] = sys.surface[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_;
+	std::vector<MeniscusEntry> entries;
+	{
+		StageTimer t(stageSeconds_, Stage::AssemblePressure);
+		meniscusTerms<Kernel>(grid_, fields_, solids_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, held, sys, entries);
+	}
+	const std::vector<char> fixed0 = sys.fixed;
+	const std::vector<Real> value0 = sys.fixedValue;
+	const std::vector<int>  master0 = sys.ghostMaster;
+	const std::vector<Real> rows0 = sys.rows;
+	lastPressureSolve_ = PressureSolveReport {};
+	for (int round = 0; round < 50; ++round) {
+		sys.rows = rows0;
+		for (const MeniscusEntry& e : entries)
+			if (held[e.owner]) sys.rows[e.row * PressureSystem::rowStride + e.slot] += e.value;
+		for (std::size_t r = 0; r < active; ++r) {
+			if (held[r]) {
+				sys.fixed[r] = 0;
+				if (!sys.ghostMaster.empty()) sys.ghostMaster[r] = -1;
+			} else {
+				sys.fixed[r] = fixed0[r], sys.fixedValue[r] = value0[r];
+				if (!sys.ghostMaster.empty()) sys.ghostMaster[r] = master0[r];
+			}
+		}
+		{
+			StageTimer t(stageSeconds_, Stage::AssemblePressure);
+			buildPressureMatrix(grid_, sys);
+		}
+		StageTimer t(stageSeconds_, Stage::SolvePressure);
+		const PressureSolveReport report = solvePressure(sys, settings_.pressureTolerance);
+		lastPressureSolve_.iterations += report.iterations;
+		lastPressureSolve_.unknowns = report.unknowns, lastPressureSolve_.fixed = report.fixed, lastPressureSolve_.residual = report.residual;
+		// at least one defect correction: the surface rows' K matches the exact projection only to the
+		// lumping of the meniscus force, and the rest lets the held surface leak (theory.md eq. 8.5e)
+		const PressureSolveReport more = correctPressureDefect<Kernel>(grid_, fields_, solids_, waters_, domain_.boundaries, settings_.gravity, water_, constrained_, heldSolid_,
+		                                                               constrained_.plate.empty() ? nullptr : &plate_, dt, solidMassTolerance_, waterMassTolerance_,
+		                                                               settings_.pressureTolerance, static_cast<int>(std::max<long>(1, settings_.pressureCorrections)), sys);
+		lastPressureSolve_.iterations += more.iterations;
+		bool released = false;
+		for (std::size_t r = 0; r < active; ++r)
+			if (held[r] && sys.nodalPressure[sys.node[r]] > 0) held[r] = 0, released = true;
+		if (!released) break;
+	}
+}
+
 template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
 {
 	using namespace stages;
@@ -531,9 +587,11 @@ template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
 		                               pressureSystem_);
 		if (!constrained_.plate.empty()) assemblePlateCoupling<Kernel>(grid_, fields_, solids_, waters_, constrained_, plate_, dt, pressureSystem_);
 		else pressureSystem_.plateCoupling.clear();
-		buildPressureMatrix(grid_, pressureSystem_);
+		if (!settings_.capillarySurface) buildPressureMatrix(grid_, pressureSystem_);
 	}
-	{
+	if (settings_.capillarySurface) {
+		projectWithCapillarySurface<Kernel>(dt);
+	} else {
 		StageTimer t(stageSeconds_, Stage::SolvePressure); // eq. 8.7
 		lastPressureSolve_ = solvePressure(pressureSystem_, settings_.pressureTolerance);
 		if (settings_.pressureCorrections > 0) {

@@ -28,6 +28,7 @@ struct SolverSettings {
 	long          pressureCorrections        = 0;     // [-] ≥ 0: defect corrections of the semi-implicit pressure towards the exact projection per step (§8.7b)
 	Real          freeSurfaceThreshold       = 0;    // β [-], 0 ≤ β < 1: p = 0 on points filled below β (eq. 2.3); 0: off
 	bool          freeSurfaceHoldsSuction    = false; // eq. 2.3b (explicit scheme only): the surface keeps suction (p < 0) and releases only p > 0
+	bool          capillarySurface           = false; // eq. 8.5e (semi-implicit scheme only): a soil surface node with the skeleton holds suction (p < 0, no relative flow) and is a seepage face (p = 0) only where it would hold p > 0
 	long          maxSubSteps                = 100000; // N_max [-] ≥ 1: advance(dt) refuses a dt that needs more sub-steps than this (a mistyped step, not a run)
 	Real          inertiaScale               = 1;    // α [-] ≥ 1: both phases' inertia × α, weights, drag and stresses not (eq. 4.8b); the step grows as √α
 	bool          reuseStencilWeights        = true;  // GIMP kernels: each point's weights computed once per position set and read by every stage of the step (theory.md §4, stencil weights); results identical bit for bit, false only to measure the gain
@@ -166,6 +167,7 @@ private:
 	template <class Kernel> void mapPointsToGrid(bool wet);
 	void                         integrateMomentum(Real dt, bool wet, bool semiImplicit);
 	template <class Kernel> void projectPressure(Real dt);
+	template <class Kernel> void projectWithCapillarySurface(Real dt);
 	template <class Kernel> void movePoints(Real dt);
 	template <class Kernel> void skeletonRates();
 	template <class Kernel> void remap(bool wet, bool solid);
