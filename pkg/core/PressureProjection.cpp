@@ -291,12 +291,13 @@ namespace stages {
 		system.fixed.assign(active, 0);
 		system.fixedValue.assign(active, 0);
 		std::vector<char> surface(active, 0); // fixed by the free-surface filling, not by a wall
+		system.dryFace.assign(active, 0);
 		for (std::size_t r = 0; r < active; ++r) {
 			const std::size_t        I   = system.node[r];
 			const std::array<int, 3> idx = grid.indices(I);
 			// wall planes and the padding beyond them: a drained face prescribes p̄(t^{n+1}), a free
 			// water face p = 0 (its natural condition, which the compact operator L does not carry)
-			bool open = false, drained = false;
+			bool open = false, drained = false, dryFace = false;
 			Real value = 0;
 			for (int axis = 0; axis < 3; ++axis) {
 				if (grid.periodic[axis]) continue;
@@ -304,14 +305,18 @@ namespace stages {
 					if (!grid.atWall(axis, side, idx[axis])) continue;
 					const WallConditions& wall = bcs.walls[2 * axis + side];
 					if (wall.water == WaterWall::Drained) {
-						drained = true;
-						value   = wall.drainedPressureAt(grid.nodePosition(idx[0], idx[1], idx[2]), gravity, waterDensity, bcs.stillWaterLevel);
+						const Vec3 x = grid.nodePosition(idx[0], idx[1], idx[2]);
+						drained      = true;
+						value        = wall.drainedPressureAt(x, gravity, waterDensity, bcs.stillWaterLevel);
+						// above its reservoir's level a drained face meets air, not water (eq. 8.5e)
+						dryFace = std::isfinite(wall.waterTable) && !wall.belowWaterTable(x, gravity) && wall.drainedPressure == 0 && !std::isfinite(bcs.stillWaterLevel);
 					} else if (wall.water == WaterWall::Free) open = true;
 				}
 			}
 			if (drained) {
 				system.fixed[r]      = 1;
 				system.fixedValue[r] = value;
+				system.dryFace[r]    = dryFace;
 			} else if (open) {
 				system.fixed[r] = 1;
 			} else {
@@ -557,6 +562,18 @@ namespace stages {
 				} else if (ur >= 0) system.rhs[ur] -= weightOf[r] * value * system.fixedValue[J];
 				else if (uJ >= 0) system.rhs[uJ] -= weightOf[J] * value * system.fixedValue[r];
 			}
+		}
+		for (const PressureSystem::NodePair& e : system.extraPairs) {
+			const std::size_t r = e.row, J = e.column;
+			const int         ur = unknownOf[r], uJ = unknownOf[J];
+			if (r == J) {
+				if (ur >= 0) add(ur, ur, weightOf[r] * weightOf[r] * e.value);
+			} else if (ur >= 0 && uJ >= 0) {
+				const Real tied = weightOf[r] * weightOf[J] * e.value;
+				if (ur == uJ) add(ur, ur, 2 * tied);
+				else add(ur, uJ, tied);
+			} else if (ur >= 0) system.rhs[ur] -= weightOf[r] * e.value * system.fixedValue[J];
+			else if (uJ >= 0) system.rhs[uJ] -= weightOf[J] * e.value * system.fixedValue[r];
 		}
 		for (int i = 0; i < n; ++i) count[i + 1] += count[i];
 		std::vector<int>&  column = system.columnScratch;
@@ -820,40 +837,64 @@ namespace stages {
 		});
 	}
 
-	template <class Kernel>
-	void meniscusTerms(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
-	                   const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
-	                   Real waterMassTolerance, const std::vector<char>& candidate, PressureSystem& system, std::vector<MeniscusEntry>& entries)
+	std::vector<Real> rowExcess(const GridGeometry& grid, const PressureSystem& system)
 	{
-		entries.clear();
+		const std::size_t active = system.node.size();
+		std::vector<Real> excess(active, 0);
+		for (std::size_t r = 0; r < active; ++r) excess[r] = system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
+		// each stored pair (r, J) of the upper half gives K_rJ p_J to row r and K_Jr p_r to row J
+		for (std::size_t r = 0; r < active; ++r) {
+			const Real*              k   = system.rows.data() + r * PressureSystem::rowStride;
+			const std::array<int, 3> idx = grid.indices(system.node[r]);
+			const Real               pr  = system.nodalPressure[system.node[r]];
+			for (int o = centreSlot; o < PressureSystem::offsets; ++o) {
+				const Real value = k[o - centreSlot];
+				if (value == 0) continue;
+				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, c = o / 25 - 2;
+				const std::size_t J  = grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c));
+				const int         rJ = system.row[J];
+				excess[r] -= value * system.nodalPressure[J];
+				if (o != centreSlot) excess[static_cast<std::size_t>(rJ)] -= value * pr;
+			}
+		}
+		for (const PressureSystem::NodePair& e : system.extraPairs) {
+			excess[e.row] -= e.value * system.nodalPressure[system.node[e.column]];
+			if (e.column != e.row) excess[e.column] -= e.value * system.nodalPressure[system.node[e.row]];
+		}
+		return excess;
+	}
+
+	template <class Kernel>
+	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, std::vector<WaterPointSet*>& sets, const ConstrainedNodes& constrained,
+	                   const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance,
+	                   const std::vector<char>& candidate, PressureSystem& system, std::vector<MeniscusPair>& pairs)
+	{
+		pairs.clear();
 		const std::size_t nodes = grid.nodeCount(), active = system.node.size();
-		const std::vector<Real> unit(nodes, 1);
-		accumulatePressureForces<Kernel>(grid, fields, solids, sets, unit, false, system);
-		std::vector<Vec3> area(nodes, Vec3::Zero());
-		std::vector<int>  slotOf(nodes, -1);
+		// the nodal response Δt M⁻¹ per axis (with the walls' holds) to a unit force on the grains and on the water
+		std::vector<Vec3> ss(nodes), ws(nodes), sw(nodes), ww(nodes);
+		system.forces.resize(nodes);
+		for (int phase = 0; phase < 2; ++phase) {
+			for (std::size_t I = 0; I < nodes; ++I)
+				system.forces[I] = phase == 0 ? PressureForceNode { Vec3::Ones(), Vec3::Zero() } : PressureForceNode { Vec3::Zero(), Vec3::Ones() };
+			forEachPressureIncrement(fields, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, system,
+			                         [&](std::size_t i, const Vec3& ds, const Vec3& dw, const std::array<bool, 3>& mixture) {
+				Vec3 s = ds, w = dw;
+				for (int d = 0; d < 3; ++d)
+					if (mixture[d]) s[d] = w[d] = ds[d] + dw[d];
+				if (phase == 0) ss[i] = s, ws[i] = w;
+				else sw[i] = s, ww[i] = w;
+			});
+		}
+		std::vector<int>         slotOf(nodes, -1);
 		std::vector<std::size_t> candidates;
 		for (std::size_t r = 0; r < active; ++r)
-			if (candidate[r]) {
-				const std::size_t I = system.node[r];
-				slotOf[I]           = static_cast<int>(candidates.size());
-				candidates.push_back(r);
-				area[I] = system.forces[I].solid + system.forces[I].water;
-			}
-		for (std::size_t I = 0; I < nodes; ++I) system.forces[I] = PressureForceNode { slotOf[I] >= 0 ? area[I] : Vec3::Zero(), Vec3::Zero() };
-		std::vector<Vec3> us(candidates.size(), Vec3::Zero()), uw(candidates.size(), Vec3::Zero());
-		std::vector<Real> diagonal(candidates.size(), 0);
-		forEachPressureIncrement(fields, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, system,
-		                         [&](std::size_t i, const Vec3& ds, const Vec3& dw, const std::array<bool, 3>& mixture) {
-			if (slotOf[i] < 0) return;
-			const int c = slotOf[i];
-			for (int d = 0; d < 3; ++d) {
-				us[c][d] = mixture[d] ? ds[d] + dw[d] : ds[d];
-				uw[c][d] = mixture[d] ? ds[d] + dw[d] : dw[d];
-			}
-			diagonal[c] = area[i].dot(us[c]);
-		});
-		std::vector<std::array<Real, 125>> cross(candidates.size());
-		for (auto& a : cross) a.fill(0);
+			if (candidate[r]) slotOf[system.node[r]] = static_cast<int>(candidates.size()), candidates.push_back(r);
+		// per candidate I and node J at offset (−2…2)³: Σ_IJ, g^s_IJ, g^w_IJ
+		struct Coupling {
+			Vec3 surface = Vec3::Zero(), solid = Vec3::Zero(), water = Vec3::Zero();
+		};
+		std::vector<std::array<Coupling, 125>> coupling(candidates.size());
 		constexpr int S = Kernel::stencil;
 		for (const WaterPointSet* set : sets) {
 			const WaterPointSet& P = *set;
@@ -869,36 +910,53 @@ namespace stages {
 				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real NJ, const Vec3& dNJ) {
 					I[m] = J, N[m] = NJ, dN[m] = dNJ, ++m;
 					n += NJ * fields.porosity[J];
-					touches = touches || (slotOf[J] >= 0 && NJ > 0);
+					touches = touches || slotOf[J] >= 0;
 				});
 				if (!touches) continue;
 				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 				const Real V = P.volume[p];
 				for (int a = 0; a < m; ++a) {
-					if (slotOf[I[a]] < 0 || N[a] == 0) continue;
-					const int                c  = slotOf[I[a]];
+					if (slotOf[I[a]] < 0) continue;
+					auto&                    c  = coupling[static_cast<std::size_t>(slotOf[I[a]])];
 					const std::array<int, 3> ia = grid.indices(I[a]);
 					for (int b = 0; b < m; ++b) {
 						const std::array<int, 3> ib = grid.indices(I[b]);
 						const int dx = ib[0] - ia[0], dy = ib[1] - ia[1], dz = ib[2] - ia[2];
-						if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap: not supported here
-						cross[c][offsetSlot(dx, dy, dz)] -= V * N[a] * ((1 - n) * dN[b].dot(us[c]) + n * dN[b].dot(uw[c]));
+						if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap: not supported
+						Coupling& e = c[offsetSlot(dx, dy, dz)];
+						e.surface += V * (N[b] * dN[a] + N[a] * dN[b]);
+						e.solid -= V * (1 - n) * N[a] * dN[b];
+						e.water -= V * n * N[a] * dN[b];
 					}
 				}
 			}
 		}
 		for (std::size_t c = 0; c < candidates.size(); ++c) {
 			const std::size_t        r   = candidates[c];
-			const std::array<int, 3> idx = grid.indices(system.node[r]);
-			for (int o = 0; o < PressureSystem::offsets; ++o) {
-				Real value = cross[c][o];
-				if (o == centreSlot) value = diagonal[c] + 2 * value;
-				if (value == 0) continue;
+			const std::size_t        I   = system.node[r];
+			const std::array<int, 3> idx = grid.indices(I);
+			int                      rowOf[125];
+			for (int o = 0; o < 125; ++o) {
+				rowOf[o]    = -1;
 				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, cc = o / 25 - 2;
-				if (o >= centreSlot) entries.push_back(MeniscusEntry { r, r, o - centreSlot, value });
-				else {
-					const int K = system.row[grid.index(idx[0] + a, idx[1] + b, idx[2] + cc)];
-					if (K >= 0) entries.push_back(MeniscusEntry { r, static_cast<std::size_t>(K), upperSlot(-a, -b, -cc), value });
+				const int x = idx[0] + a, y = idx[1] + b, z = idx[2] + cc;
+				if (x < 0 || y < 0 || z < 0 || x >= grid.nodes[0] || y >= grid.nodes[1] || z >= grid.nodes[2]) continue;
+				rowOf[o] = system.row[grid.index(x, y, z)];
+			}
+			// (M⁻¹ g_J) on the grains, per J
+			std::array<Vec3, 125> onGrains;
+			for (int o = 0; o < 125; ++o) onGrains[o] = ss[I].cwiseProduct(coupling[c][o].solid) + sw[I].cwiseProduct(coupling[c][o].water);
+			for (int j = 0; j < 125; ++j) {
+				if (rowOf[j] < 0) continue;
+				const Coupling& J = coupling[c][j];
+				for (int k = j; k < 125; ++k) {
+					if (rowOf[k] < 0) continue;
+					const Coupling& K     = coupling[c][k];
+					const Real      value = J.surface.dot(ss[I].cwiseProduct(K.surface)) + J.surface.dot(onGrains[k]) + onGrains[j].dot(K.surface);
+					if (value == 0) continue;
+					std::size_t a = static_cast<std::size_t>(rowOf[j]), b = static_cast<std::size_t>(rowOf[k]);
+					if (a > b) std::swap(a, b);
+					pairs.push_back(MeniscusPair { r, PressureSystem::NodePair { a, b, value } });
 				}
 			}
 		}
@@ -1084,9 +1142,9 @@ namespace stages {
 	                                                     std::vector<WaterPointSet*>&, const BoundaryConditions&, const Vec3&, const WaterParameters&, \
 	                                                     const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, const PlateMotion*, Real, Real, \
 	                                                     Real, Real, int, PressureSystem&);                                                          \
-	template void meniscusTerms<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&,                \
-	                               const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real, const std::vector<char>&,      \
-	                               PressureSystem&, std::vector<MeniscusEntry>&);                                                                     \
+	template void meniscusPairs<K>(const GridGeometry&, const GridFields&, std::vector<WaterPointSet*>&, const ConstrainedNodes&,                   \
+	                               const std::vector<std::array<bool, 3>>&, Real, Real, Real, const std::vector<char>&, PressureSystem&,          \
+	                               std::vector<MeniscusPair>&);                                                                                      \
 	template ProjectionForms projectionForms<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&, \
 	                                            const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,                \
 	                                            const std::vector<Real>&, PressureSystem&);                                                          \

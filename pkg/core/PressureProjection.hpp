@@ -76,6 +76,7 @@ struct PressureSystem {
 	std::vector<int>         tiedUnknown;    // per pressure node: the unknown its pressure is (free), or follows (tied), −1: prescribed
 	std::vector<Real>        tiedWeight;     // per pressure node: 1 (free) or c (tied) [-]
 	std::vector<char>        surface;        // per pressure node: on the free surface by its filling (classifyPressureNodes), not by a wall
+	std::vector<char>        dryFace;        // per pressure node: on a drained face above its reservoir's level (p̄ = 0 there: the soil meets air)
 	std::vector<Real>        rows;           // per pressure node: rowStride values (K's upper half [m³ s⁻¹ Pa⁻¹], then b [m³ s⁻¹])
 	std::vector<std::vector<Real>> rowBuffers; // per extra thread
 	std::vector<Real>        nodalPressure;   // per grid node: p^{n+1}, 0 off the pressure nodes [Pa]
@@ -92,6 +93,11 @@ struct PressureSystem {
 		int  row, column; // unknowns of an upper-half pair of K
 		Real value;
 	};
+	struct NodePair {
+		std::size_t row, column; // pressure nodes (row ≤ column: one entry stands for K_rc and K_cr)
+		Real        value;       // [m³ s⁻¹ Pa⁻¹]
+	};
+	std::vector<NodePair> extraPairs; // added to K beyond the stored rows (the held surface's terms, eq. 8.5e)
 	std::vector<FreePair> pairScratch;                              // buildPressureMatrix's scratch, kept from step to step
 	std::vector<int>      rowCount, cursorScratch, columnScratch; // (same)
 	std::vector<Real>     valueScratch;                           // (same)
@@ -134,20 +140,25 @@ namespace stages {
 	                            const WaterParameters& water, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
 	                            Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system);
 
-	// One addition to K's stored upper half: row r's slot (PressureSystem::rows), owned by the held
-	// surface node `owner` (a pressure node) whose meniscus term it belongs to (eq. 8.5e).
-	struct MeniscusEntry {
-		std::size_t owner, row;
-		int         slot;
-		Real        value;
+	// b − K p per pressure node from the stored rows and system.nodalPressure (every node's row, fixed
+	// or free, the plate's rank-one term left out): zero on a free row at convergence; on a prescribed
+	// one the volume rate its tent must shed through the boundary [m³ s⁻¹].
+	std::vector<Real> rowExcess(const GridGeometry& grid, const PressureSystem& system);
+
+	// The held surface's terms of K (theory.md eq. 8.5e): for each pressure node I with `candidate` set,
+	// Δt [f_Jᵀ M_I⁻¹ f_K − g_Jᵀ M_I⁻¹ g_K] for every pair of nodes J ≤ K its water points reach, where
+	// g_J = (−Σ_wp V (1 − n) S_I ∇S_J, −Σ_wp V n S_I ∇S_J) is the force at I of a unit pressure at J in the
+	// gradient form the compact L condenses (grains, water), f_J = g_J + (Σ_IJ, 0) adds the surface term
+	// Σ_IJ = Σ_wp V ∇(S_I S_J) on the grains (the meniscus force; zero where I's support lies inside
+	// the soil), and M_I⁻¹ is the nodal 2×2 system with the walls' holds (eq. 8.8). `owner` is I.
+	struct MeniscusPair {
+		std::size_t              owner;
+		PressureSystem::NodePair pair;
 	};
-	// Eq. 8.5e's surface terms of the candidates (pressure nodes with `candidate` set): the meniscus
-	// force a_I q_I on the grains (a_I = Σ_p V ∇S_I for a unit pressure) coupled to the compact
-	// operator's gradient forms, Δt [ΣᵀM⁻¹Σ + GᵀM⁻¹Σ + ΣᵀM⁻¹G] with Σ lumped at node I.
 	template <class Kernel>
-	void meniscusTerms(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
-	                   const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
-	                   Real waterMassTolerance, const std::vector<char>& candidate, PressureSystem& system, std::vector<MeniscusEntry>& entries);
+	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, std::vector<WaterPointSet*>& sets, const ConstrainedNodes& constrained,
+	                   const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance,
+	                   const std::vector<char>& candidate, PressureSystem& system, std::vector<MeniscusPair>& pairs);
 
 	// The rigid plate's column of B (theory.md eq. 2.9): b_J = Σ_wp V n D S_J + Σ_sp V (1 − n) D S_J with
 	// D = Σ_{I ∈ plate} ∂S_I/∂x_axis at the point, and c = Δt/M; K of eq. 8.7 gains c b bᵀ.

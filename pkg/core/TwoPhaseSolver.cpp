@@ -527,33 +527,54 @@ void TwoPhaseSolver::integrateMomentum(Real dt, bool wet, bool semiImplicit)
 // system is solved again, until no held node is positive.
 template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt)
 {
+	// the active set's rounds per step: each changes at least one node, and a surface has few; a set
+	// still changing after these is left as the last round had it
+	constexpr int maxSeepageRounds = 20;
 	using namespace stages;
-	PressureSystem& sys = pressureSystem_;
+	PressureSystem&   sys    = pressureSystem_;
 	const std::size_t active = sys.node.size();
-	std::vector<char> held(active, 0);
-	for (std::size_t r = 0; r < active; ++r) held[r] = sys.surface[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_;
-	std::vector<MeniscusEntry> entries;
+	// the surface nodes the menisci can hold: free-surface nodes, and drained-face nodes above their
+	// reservoir, that carry skeleton
+	std::vector<char> candidate(active, 0);
+	for (std::size_t r = 0; r < active; ++r) candidate[r] = (sys.surface[r] || sys.dryFace[r]) && fields_.solid[sys.node[r]].mass > solidMassTolerance_;
+	std::vector<char> held = candidate;
+	// the surface term Σ_IJ reaches the free nodes next to them too (their supports cross the surface)
+	std::vector<char> withTerms = candidate;
 	{
-		StageTimer t(stageSeconds_, Stage::AssemblePressure);
-		meniscusTerms<Kernel>(grid_, fields_, solids_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, held, sys, entries);
+		std::vector<char> near(grid_.nodeCount(), 0);
+		for (std::size_t r = 0; r < active; ++r) {
+			if (!candidate[r]) continue;
+			const std::array<int, 3> id = grid_.indices(sys.node[r]);
+			for (int c = -1; c <= 1; ++c)
+				for (int b = -1; b <= 1; ++b)
+					for (int a = -1; a <= 1; ++a) {
+						const int x = id[0] + a, y = id[1] + b, z = id[2] + c;
+						if (x >= 0 && y >= 0 && z >= 0 && x < grid_.nodes[0] && y < grid_.nodes[1] && z < grid_.nodes[2]) near[grid_.index(x, y, z)] = 1;
+					}
+		}
+		for (std::size_t r = 0; r < active; ++r)
+			withTerms[r] = withTerms[r] || (near[sys.node[r]] && !sys.fixed[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_);
+	}
+	std::vector<MeniscusPair> terms;
+	{
+		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eq. 8.5e
+		meniscusPairs<Kernel>(grid_, fields_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, withTerms, sys, terms);
 	}
 	const std::vector<char> fixed0 = sys.fixed;
 	const std::vector<Real> value0 = sys.fixedValue;
 	const std::vector<int>  master0 = sys.ghostMaster;
-	const std::vector<Real> rows0 = sys.rows;
 	lastPressureSolve_ = PressureSolveReport {};
-	for (int round = 0; round < 50; ++round) {
-		sys.rows = rows0;
-		for (const MeniscusEntry& e : entries)
-			if (held[e.owner]) sys.rows[e.row * PressureSystem::rowStride + e.slot] += e.value;
+	for (int round = 0; round < maxSeepageRounds; ++round) {
+		// a held node is a free unknown with its surface terms; a released one is a seepage-face node as
+		// classified (p = 0, or tied by eq. 8.5b), its terms dropped
+		sys.extraPairs.clear();
+		for (const MeniscusPair& e : terms)
+			if (held[e.owner] || !candidate[e.owner]) sys.extraPairs.push_back(e.pair);
 		for (std::size_t r = 0; r < active; ++r) {
-			if (held[r]) {
-				sys.fixed[r] = 0;
-				if (!sys.ghostMaster.empty()) sys.ghostMaster[r] = -1;
-			} else {
-				sys.fixed[r] = fixed0[r], sys.fixedValue[r] = value0[r];
-				if (!sys.ghostMaster.empty()) sys.ghostMaster[r] = master0[r];
-			}
+			const bool free = held[r];
+			sys.fixed[r]      = free ? 0 : fixed0[r];
+			sys.fixedValue[r] = value0[r];
+			if (!sys.ghostMaster.empty()) sys.ghostMaster[r] = free ? -1 : master0[r];
 		}
 		{
 			StageTimer t(stageSeconds_, Stage::AssemblePressure);
@@ -563,17 +584,25 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		const PressureSolveReport report = solvePressure(sys, settings_.pressureTolerance);
 		lastPressureSolve_.iterations += report.iterations;
 		lastPressureSolve_.unknowns = report.unknowns, lastPressureSolve_.fixed = report.fixed, lastPressureSolve_.residual = report.residual;
-		// at least one defect correction: the surface rows' K matches the exact projection only to the
-		// lumping of the meniscus force, and the rest lets the held surface leak (theory.md eq. 8.5e)
-		const PressureSolveReport more = correctPressureDefect<Kernel>(grid_, fields_, solids_, waters_, domain_.boundaries, settings_.gravity, water_, constrained_, heldSolid_,
-		                                                               constrained_.plate.empty() ? nullptr : &plate_, dt, solidMassTolerance_, waterMassTolerance_,
-		                                                               settings_.pressureTolerance, static_cast<int>(std::max<long>(1, settings_.pressureCorrections)), sys);
-		lastPressureSolve_.iterations += more.iterations;
-		bool released = false;
-		for (std::size_t r = 0; r < active; ++r)
-			if (held[r] && sys.nodalPressure[sys.node[r]] > 0) held[r] = 0, released = true;
-		if (!released) break;
+		if (settings_.pressureCorrections > 0) {
+			const PressureSolveReport more = correctPressureDefect<Kernel>(grid_, fields_, solids_, waters_, domain_.boundaries, settings_.gravity, water_, constrained_, heldSolid_,
+			                                                               constrained_.plate.empty() ? nullptr : &plate_, dt, solidMassTolerance_, waterMassTolerance_,
+			                                                               settings_.pressureTolerance, static_cast<int>(settings_.pressureCorrections), sys);
+			lastPressureSolve_.iterations += more.iterations;
+		}
+		// Signorini's conditions on the seepage face: a held node (no flux) must hold p ≤ 0, a released
+		// one (p = 0) must let water out, not draw it in — its row's excess b − K p, the volume rate its
+		// tent sheds through the boundary, > 0
+		const std::vector<Real> excess = rowExcess(grid_, sys);
+		bool changed = false;
+		for (std::size_t r = 0; r < active; ++r) {
+			if (!candidate[r]) continue;
+			if (held[r] && sys.nodalPressure[sys.node[r]] > 0) held[r] = 0, changed = true;
+			else if (!held[r] && excess[r] < 0) held[r] = 1, changed = true;
+		}
+		if (!changed) break;
 	}
+	sys.extraPairs.clear(); // this step's; the other paths build K without them
 }
 
 template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)

@@ -77,6 +77,14 @@ def test_out_of_range_is_refused_with_name_value_and_range(cls, key, value, mess
         setattr(obj, key, value)
 
 
+def test_capillary_surface_belongs_to_the_semi_implicit_scheme():
+    # theory.md eq. 8.5e is a term of the pressure projection; the explicit scheme's surface holds
+    # suction by freeSurfaceHoldsSuction instead, so the pair is refused with both names
+    w.MpmTwoPhaseEngine(capillarySurface=True)  # the default scheme is the semi-implicit one
+    with pytest.raises(ValueError, match=r"capillarySurface = True .* needs scheme = 'semi-implicit'"):
+        w.MpmTwoPhaseEngine(scheme="explicit", capillarySurface=True)
+
+
 def test_point_arrays_are_numpy_with_documented_shapes():
     rng = np.random.default_rng(7)
     pos = rng.random((11, 3))
