@@ -291,13 +291,12 @@ namespace stages {
 		system.fixed.assign(active, 0);
 		system.fixedValue.assign(active, 0);
 		std::vector<char> surface(active, 0); // fixed by the free-surface filling, not by a wall
-		system.dryFace.assign(active, 0);
 		for (std::size_t r = 0; r < active; ++r) {
 			const std::size_t        I   = system.node[r];
 			const std::array<int, 3> idx = grid.indices(I);
 			// wall planes and the padding beyond them: a drained face prescribes p̄(t^{n+1}), a free
 			// water face p = 0 (its natural condition, which the compact operator L does not carry)
-			bool open = false, drained = false, dryFace = false;
+			bool open = false, drained = false;
 			Real value = 0;
 			for (int axis = 0; axis < 3; ++axis) {
 				if (grid.periodic[axis]) continue;
@@ -305,18 +304,14 @@ namespace stages {
 					if (!grid.atWall(axis, side, idx[axis])) continue;
 					const WallConditions& wall = bcs.walls[2 * axis + side];
 					if (wall.water == WaterWall::Drained) {
-						const Vec3 x = grid.nodePosition(idx[0], idx[1], idx[2]);
-						drained      = true;
-						value        = wall.drainedPressureAt(x, gravity, waterDensity, bcs.stillWaterLevel);
-						// above its reservoir's level a drained face meets air, not water (eq. 8.5e)
-						dryFace = std::isfinite(wall.waterTable) && !wall.belowWaterTable(x, gravity) && wall.drainedPressure == 0 && !std::isfinite(bcs.stillWaterLevel);
+						drained = true;
+						value   = wall.drainedPressureAt(grid.nodePosition(idx[0], idx[1], idx[2]), gravity, waterDensity, bcs.stillWaterLevel);
 					} else if (wall.water == WaterWall::Free) open = true;
 				}
 			}
 			if (drained) {
 				system.fixed[r]      = 1;
 				system.fixedValue[r] = value;
-				system.dryFace[r]    = dryFace;
 			} else if (open) {
 				system.fixed[r] = 1;
 			} else {

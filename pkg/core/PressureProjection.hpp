@@ -76,7 +76,6 @@ struct PressureSystem {
 	std::vector<int>         tiedUnknown;    // per pressure node: the unknown its pressure is (free), or follows (tied), −1: prescribed
 	std::vector<Real>        tiedWeight;     // per pressure node: 1 (free) or c (tied) [-]
 	std::vector<char>        surface;        // per pressure node: on the free surface by its filling (classifyPressureNodes), not by a wall
-	std::vector<char>        dryFace;        // per pressure node: on a drained face above its reservoir's level (p̄ = 0 there: the soil meets air)
 	std::vector<Real>        rows;           // per pressure node: rowStride values (K's upper half [m³ s⁻¹ Pa⁻¹], then b [m³ s⁻¹])
 	std::vector<std::vector<Real>> rowBuffers; // per extra thread
 	std::vector<Real>        nodalPressure;   // per grid node: p^{n+1}, 0 off the pressure nodes [Pa]

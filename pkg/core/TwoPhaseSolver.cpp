@@ -533,10 +533,9 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	using namespace stages;
 	PressureSystem&   sys    = pressureSystem_;
 	const std::size_t active = sys.node.size();
-	// the surface nodes the menisci can hold: free-surface nodes, and drained-face nodes above their
-	// reservoir, that carry skeleton
+	// the surface nodes the menisci can hold: free-surface nodes that carry skeleton
 	std::vector<char> candidate(active, 0);
-	for (std::size_t r = 0; r < active; ++r) candidate[r] = (sys.surface[r] || sys.dryFace[r]) && fields_.solid[sys.node[r]].mass > solidMassTolerance_;
+	for (std::size_t r = 0; r < active; ++r) candidate[r] = sys.surface[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_;
 	std::vector<char> held = candidate;
 	// the surface term Σ_IJ reaches the free nodes next to them too (their supports cross the surface)
 	std::vector<char> withTerms = candidate;
