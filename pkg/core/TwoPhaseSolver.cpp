@@ -533,9 +533,13 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	using namespace stages;
 	PressureSystem&   sys    = pressureSystem_;
 	const std::size_t active = sys.node.size();
-	// the surface nodes the menisci can hold: free-surface nodes that carry skeleton
+	// the surface nodes the menisci can hold: free-surface nodes that carry skeleton, not those beyond a
+	// wall (reached by the round-off tail of the weights only: their rows are all but empty)
 	std::vector<char> candidate(active, 0);
-	for (std::size_t r = 0; r < active; ++r) candidate[r] = sys.surface[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_;
+	for (std::size_t r = 0; r < active; ++r) {
+		const std::array<int, 3> id = grid_.indices(sys.node[r]);
+		candidate[r] = sys.surface[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_ && grid_.inDomainSupportVolume(id[0], id[1], id[2]) > 0;
+	}
 	std::vector<char> held = candidate;
 	// the surface term Σ_IJ reaches the free nodes next to them too (their supports cross the surface)
 	std::vector<char> withTerms = candidate;
