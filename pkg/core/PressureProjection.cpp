@@ -859,6 +859,10 @@ namespace stages {
 		return excess;
 	}
 
+	// Σ_IJ below this share of node I's largest counts as round-off (eq. 8.5e): the sum over points of
+	// ∇(S_I S_J) over a support inside the soil cancels to the points' quadrature error
+	constexpr Real surfaceShareTolerance = 1e-9;
+
 	template <class Kernel>
 	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, std::vector<WaterPointSet*>& sets, const ConstrainedNodes& constrained,
 	                   const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance,
@@ -941,11 +945,22 @@ namespace stages {
 			// (M⁻¹ g_J) on the grains, per J
 			std::array<Vec3, 125> onGrains;
 			for (int o = 0; o < 125; ++o) onGrains[o] = ss[I].cwiseProduct(coupling[c][o].solid) + sw[I].cwiseProduct(coupling[c][o].water);
-			for (int j = 0; j < 125; ++j) {
-				if (rowOf[j] < 0) continue;
+			// the surface term of a node J whose product support with I lies inside the soil is round-off:
+			// only the J with a surface share take part (a pair needs Σ_IJ or Σ_IK)
+			Real largest = 0;
+			for (int o = 0; o < 125; ++o) largest = std::max(largest, coupling[c][o].surface.norm());
+			if (!(largest > 0)) continue;
+			const Real negligible = surfaceShareTolerance * largest;
+			int        reached[125], surfaced[125], m = 0;
+			for (int o = 0; o < 125; ++o)
+				if (rowOf[o] >= 0) reached[m++] = o;
+			for (int o = 0; o < 125; ++o) surfaced[o] = coupling[c][o].surface.norm() > negligible;
+			for (int x = 0; x < m; ++x) {
+				const int       j = reached[x];
 				const Coupling& J = coupling[c][j];
-				for (int k = j; k < 125; ++k) {
-					if (rowOf[k] < 0) continue;
+				for (int y = x; y < m; ++y) {
+					const int k = reached[y];
+					if (!surfaced[j] && !surfaced[k]) continue;
 					const Coupling& K     = coupling[c][k];
 					const Real      value = J.surface.dot(ss[I].cwiseProduct(K.surface)) + J.surface.dot(onGrains[k]) + onGrains[j].dot(K.surface);
 					if (value == 0) continue;
