@@ -531,6 +531,10 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	// the active set's rounds per step: each changes at least one node, and a surface has few; a set
 	// still changing after these is left as the last round had it
 	constexpr int maxSeepageRounds = 20;
+	// the least water filling V^w_I/V^full_I of a held node: a node whose support the water reaches only
+	// by the tails of its points' weights (more than a cell beyond the surface; a plane surface 0.95 h
+	// below a node fills it to 1.25e-3) has a row all but empty, and held free it leaves K near singular
+	constexpr Real heldSurfaceFilling = 1e-3;
 	using namespace stages;
 	PressureSystem&   sys    = pressureSystem_;
 	const std::size_t active = sys.node.size();
@@ -538,8 +542,10 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	// wall (reached by the round-off tail of the weights only: their rows are all but empty)
 	std::vector<char> candidate(active, 0);
 	for (std::size_t r = 0; r < active; ++r) {
-		const std::array<int, 3> id = grid_.indices(sys.node[r]);
-		candidate[r] = sys.surface[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_ && grid_.inDomainSupportVolume(id[0], id[1], id[2]) > 0;
+		const std::array<int, 3> id   = grid_.indices(sys.node[r]);
+		const Real               full = grid_.inDomainSupportVolume(id[0], id[1], id[2]);
+		candidate[r] = sys.surface[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_ && full > 0 &&
+		               fields_.water[sys.node[r]].volume >= heldSurfaceFilling * full;
 	}
 	std::vector<char> held = candidate;
 	// the surface term Σ_IJ reaches the free nodes next to them too (their supports cross the surface)
