@@ -871,18 +871,19 @@ namespace stages {
 		pairs.clear();
 		const std::size_t nodes = grid.nodeCount(), active = system.node.size();
 		// the nodal response Δt M⁻¹ per axis (with the walls' holds) to a unit force on the grains and on the water
-		std::vector<Vec3> ss(nodes), ws(nodes), sw(nodes), ww(nodes);
+		std::vector<Vec3>& ss = system.grainResponse[0];
+		std::vector<Vec3>& sw = system.grainResponse[1];
+		ss.resize(nodes), sw.resize(nodes);
 		system.forces.resize(nodes);
 		for (int phase = 0; phase < 2; ++phase) {
 			for (std::size_t I = 0; I < nodes; ++I)
 				system.forces[I] = phase == 0 ? PressureForceNode { Vec3::Ones(), Vec3::Zero() } : PressureForceNode { Vec3::Zero(), Vec3::Ones() };
 			forEachPressureIncrement(fields, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, system,
 			                         [&](std::size_t i, const Vec3& ds, const Vec3& dw, const std::array<bool, 3>& mixture) {
-				Vec3 s = ds, w = dw;
+				Vec3 s = ds;
 				for (int d = 0; d < 3; ++d)
-					if (mixture[d]) s[d] = w[d] = ds[d] + dw[d];
-				if (phase == 0) ss[i] = s, ws[i] = w;
-				else sw[i] = s, ww[i] = w;
+					if (mixture[d]) s[d] = ds[d] + dw[d];
+				(phase == 0 ? ss : sw)[i] = s; // the grains' response to a force on the grains, on the water
 			});
 		}
 		std::vector<int>         slotOf(nodes, -1);
@@ -890,10 +891,10 @@ namespace stages {
 		for (std::size_t r = 0; r < active; ++r)
 			if (candidate[r]) slotOf[system.node[r]] = static_cast<int>(candidates.size()), candidates.push_back(r);
 		// per candidate I and node J at offset (−2…2)³: Σ_IJ, g^s_IJ, g^w_IJ
-		struct Coupling {
-			Vec3 surface = Vec3::Zero(), solid = Vec3::Zero(), water = Vec3::Zero();
-		};
-		std::vector<std::array<Coupling, 125>> coupling(candidates.size());
+		using Coupling = PressureSystem::SurfaceCoupling;
+		std::vector<std::array<Coupling, 125>>& coupling = system.surfaceCoupling; // kept from step to step: its allocation was a tenth of the step
+		coupling.resize(candidates.size());
+		for (auto& c : coupling) c.fill(Coupling {});
 		constexpr int S = Kernel::stencil;
 		for (const WaterPointSet* set : sets) {
 			const WaterPointSet& P = *set;
@@ -914,12 +915,14 @@ namespace stages {
 				if (!touches) continue;
 				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 				const Real V = P.volume[p];
+				std::array<int, 3> at[S * S * S];
+				for (int a = 0; a < m; ++a) at[a] = grid.indices(I[a]);
 				for (int a = 0; a < m; ++a) {
 					if (slotOf[I[a]] < 0) continue;
-					auto&                    c  = coupling[static_cast<std::size_t>(slotOf[I[a]])];
-					const std::array<int, 3> ia = grid.indices(I[a]);
+					auto&                     c  = coupling[static_cast<std::size_t>(slotOf[I[a]])];
+					const std::array<int, 3>& ia = at[a];
 					for (int b = 0; b < m; ++b) {
-						const std::array<int, 3> ib = grid.indices(I[b]);
+						const std::array<int, 3>& ib = at[b];
 						const int dx = ib[0] - ia[0], dy = ib[1] - ia[1], dz = ib[2] - ia[2];
 						if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap: not supported
 						Coupling& e = c[offsetSlot(dx, dy, dz)];

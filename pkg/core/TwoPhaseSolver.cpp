@@ -565,7 +565,7 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		for (std::size_t r = 0; r < active; ++r)
 			withTerms[r] = withTerms[r] || (near[sys.node[r]] && !sys.fixed[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_);
 	}
-	std::vector<MeniscusPair> terms;
+	std::vector<MeniscusPair>& terms = meniscusPairs_;
 	{
 		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eq. 8.5e
 		meniscusPairs<Kernel>(grid_, fields_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, withTerms, sys, terms);
@@ -573,7 +573,7 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	const std::vector<char> fixed0 = sys.fixed;
 	const std::vector<Real> value0 = sys.fixedValue;
 	const std::vector<int>  master0 = sys.ghostMaster;
-	std::unordered_map<std::size_t, Real> merged;
+	std::unordered_map<std::size_t, Real>& merged = mergedMeniscusPairs_;
 	lastPressureSolve_ = PressureSolveReport {};
 	for (int round = 0; round < maxSeepageRounds; ++round) {
 		// a held node is a free unknown with its surface terms; a released one is a seepage-face node as

@@ -11,6 +11,7 @@
 #include <array>
 #include <atomic>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace mpm {
@@ -168,6 +169,8 @@ private:
 	void                         integrateMomentum(Real dt, bool wet, bool semiImplicit);
 	template <class Kernel> void projectPressure(Real dt);
 	template <class Kernel> void projectWithCapillarySurface(Real dt);
+	std::vector<stages::MeniscusPair>          meniscusPairs_;       // eq. 8.5e's node-pair shares, kept from step to step
+	std::unordered_map<std::size_t, Real>      mergedMeniscusPairs_; // (same), summed per pair of nodes
 	template <class Kernel> void movePoints(Real dt);
 	template <class Kernel> void skeletonRates();
 	template <class Kernel> void remap(bool wet, bool solid);
