@@ -924,7 +924,7 @@ namespace stages {
 					for (int b = 0; b < m; ++b) {
 						const std::array<int, 3>& ib = at[b];
 						const int dx = ib[0] - ia[0], dy = ib[1] - ia[1], dz = ib[2] - ia[2];
-						if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap: not supported
+						if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap (refused at setup)
 						Coupling& e = c[offsetSlot(dx, dy, dz)];
 						e.surface += V * (N[b] * dN[a] + N[a] * dN[b]);
 						e.solid -= V * (1 - n) * N[a] * dN[b];

@@ -146,6 +146,9 @@ TwoPhaseSolver::TwoPhaseSolver(const Domain& domain, const SolverSettings& setti
 	for (int f = 0; f < faceCount; ++f)
 		if (domain_.boundaries.walls[f].inflow && domain_.boundaries.walls[f].water != WaterWall::Drained)
 			throw InvalidParameter(std::string("the inflow face ") + faceName(f) + " must be a drained water wall");
+	// eq. 8.5e's node pairs are gathered by unwrapped index offsets
+	if (settings_.capillarySurface && (domain_.boundaries.periodic[0] || domain_.boundaries.periodic[1] || domain_.boundaries.periodic[2]))
+		throw InvalidParameter("capillarySurface = True does not take a periodic axis yet (theory.md eq. 8.5e): set periodic = (False, False, False) or capillarySurface = False");
 	fields_.resize(grid_.nodeCount());
 	constrained_ = ConstrainedNodes::build(grid_, domain.boundaries);
 }
@@ -523,9 +526,10 @@ void TwoPhaseSolver::integrateMomentum(Real dt, bool wet, bool semiImplicit)
 	if (!constrained_.plate.empty()) moveRigidPlate(fields_, constrained_, dt, solidMassTolerance_, waterMassTolerance_, plate_); // eq. 2.9
 }
 
-// Eq. 8.5e: the soil's surface nodes hold suction (free, with the meniscus term on K's diagonal) until
-// the solve gives one of them p > 0; those become seepage-face nodes (p = 0, or tied as eq. 8.5b) and the
-// system is solved again, until no held node is positive.
+// Eq. 8.5e: the soil's surface nodes hold suction (free unknowns, K with the meniscus force's surface
+// terms) while the solve gives them p ≤ 0; one with p > 0 becomes a seepage-face node (p = 0, or tied as
+// eq. 8.5b), one of those that would draw water in is held again, and the system is solved again until
+// the set no longer changes.
 template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt)
 {
 	// the active set's rounds per step: each changes at least one node, and a surface has few; a set
