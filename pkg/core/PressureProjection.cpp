@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <cstring>
 #include <limits>
 #include <sstream>
@@ -324,7 +325,7 @@ namespace stages {
 			}
 		}
 		tieSurfaceNodes(grid, fields, sets, waterDensity, surface, system);
-		system.surface = surface;
+		system.surface = std::move(surface); // not read here after the ties
 	}
 
 	template <class Kernel>
