@@ -303,6 +303,9 @@ while O.time < DURATION - 1e-12:
         steps_start = time.time()
         for _ in range(steps_per_record):
             engine.drainedWaterTable = head_table(O.time)
+            # the release of α is armed once the pile has settled at its starting head: the settling
+            # from the K0 starting stresses is the start-up imbalance eq. 4.8c must not take for a slide
+            engine.inertiaScaleRelease = args.inertia_release if O.time >= SCENE.settle_time - 1e-12 else float("inf")
             O.step()  # synchronous in this thread: O.run(1, True) waits on YADE's thread for tens of ms per call
             recorder.dead = True
         solver_time += time.time() - steps_start
@@ -323,6 +326,7 @@ while O.time < DURATION - 1e-12:
     row = {"time_s": O.time, "head_m": SCENE.head(O.time), "toe_displacement_m": toe_displacement(), "face_displacement_m": face_displacement(),
            "max_solid_speed_m_per_s": float(speed.max()), "water_points": fluid.count, "injected_kg": engine.injectedWaterMass,
            "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual, "inertia_scale": engine.inertiaScale,
+           "inertia_ratio": engine.inertiaRatio,
            "kinetic_energy_J": yade_mpm.analysis.kinetic_energy(solid.mass, solid.vel)}
     row.update({"p_%s_Pa" % name.replace(" ", "_"): probe_pressure(loc) for name, loc in PROBES.items()})  # e.g. p_upstream_x=0.05_Pa
     # Bishop's factor of safety on the run's own pressure field, at every HDF5 frame (about 1 s each)

@@ -909,6 +909,14 @@ void TwoPhaseSolver::updateDrainedValues(const BoundaryConditions& boundaries)
 	}
 }
 
+void TwoPhaseSolver::setInertiaScaleRelease(Real threshold)
+{
+	SolverSettings changed       = settings_;
+	changed.inertiaScaleRelease = threshold;
+	changed.validate();
+	settings_.inertiaScaleRelease = threshold;
+}
+
 // Water entering through an inflow face (theory.md eq. 2.5). The face is tiled in rows one point
 // spacing s = 2 l_p wide (l_p: the set's regular half-length; lattice sets tile the face exactly).
 // Between the face and the domain of a row's outermost regular point lies a gap of depth g: water

@@ -120,6 +120,9 @@ public:
 	// Replace the values held on the faces (p̄, water table and traction, e.g. a rising head or a load
 	// ramp) without rebuilding the solver; the kinds of the walls must stay as they were built.
 	void updateDrainedValues(const BoundaryConditions& boundaries);
+	// Replace the release threshold ε of eq. 4.8c (> 0, inf: never) without rebuilding the solver, e.g.
+	// armed once a scene has settled from its starting stresses (InvalidParameter outside (0, inf]).
+	void setInertiaScaleRelease(Real threshold);
 	const std::array<double, static_cast<int>(Stage::Count)>& stageSeconds() const { return stageSeconds_; }
 	const GridGeometry&                                 grid() const { return grid_; }
 	// The last semi-implicit pressure solve (zeros before the first one or with the explicit scheme).

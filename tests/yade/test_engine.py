@@ -368,7 +368,8 @@ def test_every_input_rebuilds_the_solver_unless_it_is_held_on_the_faces():
     Inputs are rebuild-by-default, so none can be forgotten: setting any input (here to the value it
     has, always valid) makes the next step start a new solver (solverSteps restarts), except the
     values held on the faces (drainedPressure, faceTraction, drainedWaterTable), which a running
-    solver takes over in place (a head raised every step must not rebuild the grid)."""
+    solver takes over in place (a head raised every step must not rebuild the grid), and the
+    inertia scaling's release threshold (armed once a scene has settled, theory.md eq. 4.8c)."""
     soil, water = w.MpmSoilMat(), w.MpmWaterMat()
     O.materials.append([soil, water])
     g = (0, 0, -9.81)
@@ -378,7 +379,7 @@ def test_every_input_rebuilds_the_solver_unless_it_is_held_on_the_faces():
     O.engines = [engine]
     O.dt = 1e-4
     O.step()
-    in_place = {"drainedPressure", "faceTraction", "drainedWaterTable"}
+    in_place = {"drainedPressure", "faceTraction", "drainedWaterTable", "inertiaScaleRelease"}
     inputs = sorted(a for a, p in vars(w.MpmTwoPhaseEngine).items() if isinstance(p, property) and p.fset is not None)
     assert in_place < set(inputs) and len(inputs) >= 25
     for attribute in inputs:

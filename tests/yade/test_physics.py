@@ -353,6 +353,47 @@ def test_inertia_scale_is_released_when_a_block_starts_to_slide_and_the_release_
     assert O.engines[0].inertiaScale == 1 and O.engines[0].inertiaScaleReleaseTime == pytest.approx(1e-3, rel=1e-9)
 
 
+def test_inertia_scale_release_armed_in_place_after_a_held_phase():
+    """theory.md eq. 4.8c, its arming: the block of the test above (a = g (sin θ − μ cos θ) unscaled)
+    with the release disarmed (inertiaScaleRelease = inf) keeps α = 10 and slides at a/α (the scaled
+    inertia, 1% — the elastic start's share); armed in place after 0.05 s (0.1, set on the running
+    engine) α returns to 1 in the next O.dt without rebuilding the solver (solverSteps keeps
+    counting), and from then on the block gains a per second (Coulomb's unscaled slide, 2%)."""
+    theta, mu, cell, g = np.radians(45), np.tan(np.radians(30)), 0.05, 9.81
+    a = g * (np.sin(theta) - mu * np.cos(theta))
+    soil = w.MpmSoilMat(density=2650, youngModulus=5e6, poissonRatio=0.0, porosity=0.4)
+    water = w.MpmWaterMat()
+    O.materials.append([soil, water])
+    solid_body, _ = yade_mpm.saturated_block((2 * cell, 2 * cell, 0), (10 * cell, 4 * cell, 2 * cell), cell, soil, water, geostatic=False)
+    solid = solid_body.shape
+    weight_above = 0.6 * 2650 * g * (2 * cell - solid.pos[:, 2])
+    stress = np.zeros((solid.count, 3, 3))
+    stress[:, 2, 2] = -weight_above * np.cos(theta)
+    stress[:, 0, 2] = stress[:, 2, 0] = weight_above * np.sin(theta)
+    solid.stress = stress
+    O.bodies.append(solid_body)
+    engine = w.MpmTwoPhaseEngine(label="mpm", gravity=(g * np.sin(theta), 0, -g * np.cos(theta)), domainMin=(0, 0, 0),
+                                 domainMax=(40 * cell, 6 * cell, 4 * cell), cellSize=cell, solidWalls=("free",) * 4 + ("frictional", "free"),
+                                 wallFriction=(0, 0, 0, 0, mu, 0), inertiaScale=10, inertiaScaleRelease=float("inf"))
+    O.engines = [engine]
+    O.dt = 1e-3
+
+    def speed():
+        return float((solid.mass * solid.vel[:, 0]).sum() / solid.mass.sum())
+
+    O.run(50, True)
+    assert engine.inertiaScale == 10 and engine.inertiaScaleReleaseTime == -1
+    assert speed() == pytest.approx(a / 10 * O.time, rel=0.01)
+    steps = engine.solverSteps
+    engine.inertiaScaleRelease = 0.1
+    O.run(1, True)
+    assert engine.inertiaScale == 1 and engine.inertiaScaleReleaseTime == pytest.approx(0.051, rel=1e-9)
+    assert engine.solverSteps == steps + engine.subStepsLast  # armed in place: the solver was not rebuilt
+    released_speed = speed()
+    O.run(49, True)
+    assert speed() - released_speed == pytest.approx(a * 0.049, rel=0.02)
+
+
 def column_of_points(height, cell, **saturated):
     """A one-cell-wide column of 2×2 points per cell layer up to `height` [m] under a free top two
     cells above it, semi-implicit, k = 1e-3 m/s, real water; `saturated` goes to
