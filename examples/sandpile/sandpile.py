@@ -305,7 +305,9 @@ while O.time < DURATION - 1e-12:
             engine.drainedWaterTable = head_table(O.time)
             # the release of α is armed once the pile has settled at its starting head: the settling
             # from the K0 starting stresses is the start-up imbalance eq. 4.8c must not take for a slide
-            engine.inertiaScaleRelease = args.inertia_release if O.time >= SCENE.settle_time - 1e-12 else float("inf")
+            release = args.inertia_release if O.time >= SCENE.settle_time - 1e-12 else float("inf")
+            if engine.inertiaScaleRelease != release:
+                engine.inertiaScaleRelease = release  # in place: the solver is not rebuilt
             O.step()  # synchronous in this thread: O.run(1, True) waits on YADE's thread for tens of ms per call
             recorder.dead = True
         solver_time += time.time() - steps_start
