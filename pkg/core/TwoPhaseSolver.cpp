@@ -4,7 +4,6 @@
 #include "Stencil.hpp"
 
 #include <algorithm>
-#include <unordered_map>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -577,17 +576,48 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	const std::vector<char> fixed0 = sys.fixed;
 	const std::vector<Real> value0 = sys.fixedValue;
 	const std::vector<int>  master0 = sys.ghostMaster;
-	std::unordered_map<std::size_t, Real>& merged = mergedMeniscusPairs_;
+	// many owners share a pair of nodes (~10⁵ shares on ~10³ pairs): the pairs are numbered once per
+	// step (shares bucketed by row, then by column with a per-node mark: O(shares + nodes)) and the
+	// shares of the free nodes next to the held ones, which count in every round, summed once; a round
+	// adds the shares of the candidates it holds
+	std::vector<PressureSystem::NodePair>& nodePairs = meniscusNodePairs_;
+	std::vector<std::size_t>&              pairOf    = meniscusPairOf_;
+	{
+		std::vector<std::size_t>& start = meniscusScratch_[0];
+		std::vector<std::size_t>& order = meniscusScratch_[1];
+		std::vector<std::size_t>& mark  = meniscusScratch_[2];
+		start.assign(active + 1, 0);
+		for (const MeniscusPair& e : terms) ++start[e.pair.row + 1];
+		for (std::size_t r = 0; r < active; ++r) start[r + 1] += start[r];
+		order.resize(terms.size());
+		for (std::size_t t = 0; t < terms.size(); ++t) order[start[terms[t].pair.row]++] = t; // start[r] ends at row r + 1's start
+		mark.assign(active, std::numeric_limits<std::size_t>::max()); // the pair index of (row, column) for the row being visited
+		nodePairs.clear();
+		pairOf.resize(terms.size());
+		std::size_t from = 0;
+		for (std::size_t r = 0; r < active; ++r) {
+			const std::size_t first = nodePairs.size();
+			for (; from < start[r]; ++from) {
+				const std::size_t t = order[from], c = terms[t].pair.column;
+				if (mark[c] == std::numeric_limits<std::size_t>::max() || mark[c] < first)
+					mark[c] = nodePairs.size(), nodePairs.push_back(PressureSystem::NodePair { r, c, 0 });
+				pairOf[t] = mark[c];
+			}
+		}
+		order.clear(); // from here: the candidates' shares
+		for (std::size_t t = 0; t < terms.size(); ++t) {
+			if (candidate[terms[t].owner]) order.push_back(t);
+			else nodePairs[pairOf[t]].value += terms[t].pair.value;
+		}
+	}
+	const std::vector<std::size_t>& candidateShares = meniscusScratch_[1];
 	lastPressureSolve_ = PressureSolveReport {};
 	for (int round = 0; round < maxSeepageRounds; ++round) {
 		// a held node is a free unknown with its surface terms; a released one is a seepage-face node as
 		// classified (p = 0, or tied by eq. 8.5b), its terms dropped
-		// the owners' shares summed per pair of nodes (many nodes share a pair: ~10⁵ shares, ~10³ pairs)
-		merged.clear();
-		for (const MeniscusPair& e : terms)
-			if (held[e.owner] || !candidate[e.owner]) merged[e.pair.row * active + e.pair.column] += e.pair.value;
-		sys.extraPairs.clear();
-		for (const auto& [key, value] : merged) sys.extraPairs.push_back(PressureSystem::NodePair { key / active, key % active, value });
+		sys.extraPairs.assign(nodePairs.begin(), nodePairs.end());
+		for (const std::size_t t : candidateShares)
+			if (held[terms[t].owner]) sys.extraPairs[pairOf[t]].value += terms[t].pair.value;
 		for (std::size_t r = 0; r < active; ++r) {
 			const bool free = held[r];
 			sys.fixed[r]      = free ? 0 : fixed0[r];

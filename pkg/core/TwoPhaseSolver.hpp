@@ -11,7 +11,6 @@
 #include <array>
 #include <atomic>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 namespace mpm {
@@ -173,7 +172,9 @@ private:
 	template <class Kernel> void projectPressure(Real dt);
 	template <class Kernel> void projectWithCapillarySurface(Real dt);
 	std::vector<stages::MeniscusPair>          meniscusPairs_;       // eq. 8.5e's node-pair shares, kept from step to step
-	std::unordered_map<std::size_t, Real>      mergedMeniscusPairs_; // (same), summed per pair of nodes
+	std::vector<PressureSystem::NodePair>      meniscusNodePairs_;   // (same): the distinct pairs of nodes they fall on
+	std::vector<std::size_t>                   meniscusPairOf_;      // (same): per share, its entry in meniscusNodePairs_
+	std::vector<std::size_t>                   meniscusScratch_[3];  // (same): bucket starts, order by row, per-node marks
 	template <class Kernel> void movePoints(Real dt);
 	template <class Kernel> void skeletonRates();
 	template <class Kernel> void remap(bool wet, bool solid);
