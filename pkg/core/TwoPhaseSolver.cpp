@@ -550,12 +550,7 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		candidate[r] = sys.surface[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_ && full > 0 &&
 		               fields_.water[sys.node[r]].volume >= heldSurfaceFilling * full;
 	}
-	// the active set starts from the last step's at the same grid nodes (a node new to the surface
-	// starts held): started from all held, every step took three rounds, one solve each
-	std::vector<char>& released = releasedSurface_; // per grid node
-	released.resize(grid_.nodeCount(), 0);
-	std::vector<char> held(active, 0);
-	for (std::size_t r = 0; r < active; ++r) held[r] = candidate[r] && !released[sys.node[r]];
+	std::vector<char> held = candidate;
 	// the surface term Σ_IJ reaches the free nodes next to them too (their supports cross the surface)
 	std::vector<char> withTerms = candidate;
 	{
@@ -655,8 +650,6 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		}
 		if (!changed) break;
 	}
-	std::fill(released.begin(), released.end(), 0);
-	for (std::size_t r = 0; r < active; ++r) released[sys.node[r]] = candidate[r] && !held[r];
 	sys.extraPairs.clear(); // this step's; the other paths build K without them
 }
 
