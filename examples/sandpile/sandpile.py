@@ -68,7 +68,8 @@ parser.add_argument("--inertia-scale", type=float, default=1.0, help="inertia sc
                                                                      "by itself when the pile accelerates (eq. 4.8c)")
 parser.add_argument("--inertia-release", type=float, default=0.1,
                     help="release threshold ε of the inertia scaling (engine inertiaScaleRelease, theory.md eq. 4.8c): the skeleton's "
-                         "net inertial force over its weight; a slide of a fraction f of the pile shows as about f × its imbalance")
+                         "net inertial force over its weight; a slide of a fraction f of the pile shows as about f × its imbalance. "
+                         "Armed at the end of the settling time (the settling from the starting stresses is no slide)")
 parser.add_argument("--ramp-time", type=float, help="duration of the head rise [s] (default the scene's 0.3 s)")
 parser.add_argument("--settle-time", type=float, help="time at the starting head before the rise [s] (default the scene's 0.05 s)")
 parser.add_argument("--hold-time", type=float, help="head held at the crest after the rise [s] (default the scene's 0.35 s)")
