@@ -319,48 +319,12 @@ def test_a_plate_needs_an_impermeable_face_and_is_unique():
     assert engine.solidWalls[5] == "plate"
 
 
-def test_inertia_scale_is_released_when_a_block_starts_to_slide_and_the_release_is_saved(tmp_path):
-    """theory.md eqs. 4.8b–c through YADE: a dry block on a 30° frictional base under gravity tilted
-    by 45° (it must slide, at a = g (sin θ − μ cos θ)) with inertiaScale = 10. Its net inertial force
-    is 0.30 of its weight, above inertiaScaleRelease = 0.1, so α returns to 1 in the first O.dt:
-    the attribute reads 1, inertiaScaleReleaseTime that O.dt's end, and the block's speed after
-    0.1 s is Coulomb's within 2% (the unscaled slide); both survive O.save/O.load."""
+def sliding_block(inertia_release):
+    """A dry block on a 30° frictional base under gravity tilted by 45° (it must slide, at
+    a = g (sin θ − μ cos θ)), its stress the stuck slab's (no elastic drop), with inertiaScale = 10 and
+    the given inertiaScaleRelease; O.dt = 1 ms. Returns the engine, the block's mean speed along
+    the slope as a function, and a [m s⁻²]."""
     theta, mu, cell, g = np.radians(45), np.tan(np.radians(30)), 0.05, 9.81
-    soil = w.MpmSoilMat(density=2650, youngModulus=5e6, poissonRatio=0.0, porosity=0.4)
-    water = w.MpmWaterMat()
-    O.materials.append([soil, water])
-    solid_body, _ = yade_mpm.saturated_block((2 * cell, 2 * cell, 0), (10 * cell, 4 * cell, 2 * cell), cell, soil, water, geostatic=False)
-    solid = solid_body.shape
-    weight_above = 0.6 * 2650 * g * (2 * cell - solid.pos[:, 2])  # the stuck slab's stress: no elastic drop
-    stress = np.zeros((solid.count, 3, 3))
-    stress[:, 2, 2] = -weight_above * np.cos(theta)
-    stress[:, 0, 2] = stress[:, 2, 0] = weight_above * np.sin(theta)
-    solid.stress = stress
-    O.bodies.append(solid_body)
-    engine = w.MpmTwoPhaseEngine(label="mpm", gravity=(g * np.sin(theta), 0, -g * np.cos(theta)), domainMin=(0, 0, 0),
-                                 domainMax=(40 * cell, 6 * cell, 4 * cell), cellSize=cell, solidWalls=("free",) * 4 + ("frictional", "free"),
-                                 wallFriction=(0, 0, 0, 0, mu, 0), inertiaScale=10, inertiaScaleRelease=0.1)
-    O.engines = [engine]
-    O.dt = 1e-3
-    O.run(100, True)
-    assert engine.inertiaScale == 1
-    assert engine.inertiaScaleReleaseTime == pytest.approx(1e-3, rel=1e-9)
-    speed = float((solid.mass * solid.vel[:, 0]).sum() / solid.mass.sum())
-    assert speed == pytest.approx(g * (np.sin(theta) - mu * np.cos(theta)) * O.time, rel=0.02)
-    path = str(tmp_path / "released.xml.bz2")
-    O.save(path)
-    O.load(path)
-    assert O.engines[0].inertiaScale == 1 and O.engines[0].inertiaScaleReleaseTime == pytest.approx(1e-3, rel=1e-9)
-
-
-def test_inertia_scale_release_armed_in_place_after_a_held_phase():
-    """theory.md eq. 4.8c, its arming: the block of the test above (a = g (sin θ − μ cos θ) unscaled)
-    with the release disarmed (inertiaScaleRelease = inf) keeps α = 10 and slides at a/α (the scaled
-    inertia, 1% — the elastic start's share); armed in place after 0.05 s (0.1, set on the running
-    engine) α returns to 1 in the next O.dt without rebuilding the solver (solverSteps keeps
-    counting), and from then on the block gains a per second (Coulomb's unscaled slide, 2%)."""
-    theta, mu, cell, g = np.radians(45), np.tan(np.radians(30)), 0.05, 9.81
-    a = g * (np.sin(theta) - mu * np.cos(theta))
     soil = w.MpmSoilMat(density=2650, youngModulus=5e6, poissonRatio=0.0, porosity=0.4)
     water = w.MpmWaterMat()
     O.materials.append([soil, water])
@@ -374,13 +338,39 @@ def test_inertia_scale_release_armed_in_place_after_a_held_phase():
     O.bodies.append(solid_body)
     engine = w.MpmTwoPhaseEngine(label="mpm", gravity=(g * np.sin(theta), 0, -g * np.cos(theta)), domainMin=(0, 0, 0),
                                  domainMax=(40 * cell, 6 * cell, 4 * cell), cellSize=cell, solidWalls=("free",) * 4 + ("frictional", "free"),
-                                 wallFriction=(0, 0, 0, 0, mu, 0), inertiaScale=10, inertiaScaleRelease=float("inf"))
+                                 wallFriction=(0, 0, 0, 0, mu, 0), inertiaScale=10, inertiaScaleRelease=inertia_release)
     O.engines = [engine]
     O.dt = 1e-3
 
     def speed():
         return float((solid.mass * solid.vel[:, 0]).sum() / solid.mass.sum())
 
+    return engine, speed, g * (np.sin(theta) - mu * np.cos(theta))
+
+
+def test_inertia_scale_is_released_when_a_block_starts_to_slide_and_the_release_is_saved(tmp_path):
+    """theory.md eqs. 4.8b–c through YADE: the sliding block (sliding_block) with inertiaScale = 10.
+    Its net inertial force is 0.30 of its weight, above inertiaScaleRelease = 0.1, so α returns to 1
+    in the first O.dt: the attribute reads 1, inertiaScaleReleaseTime that O.dt's end, and the
+    block's speed after 0.1 s is Coulomb's within 2% (the unscaled slide); both survive O.save/O.load."""
+    engine, speed, a = sliding_block(0.1)
+    O.run(100, True)
+    assert engine.inertiaScale == 1
+    assert engine.inertiaScaleReleaseTime == pytest.approx(1e-3, rel=1e-9)
+    assert speed() == pytest.approx(a * O.time, rel=0.02)
+    path = str(tmp_path / "released.xml.bz2")
+    O.save(path)
+    O.load(path)
+    assert O.engines[0].inertiaScale == 1 and O.engines[0].inertiaScaleReleaseTime == pytest.approx(1e-3, rel=1e-9)
+
+
+def test_inertia_scale_release_armed_in_place_after_a_held_phase():
+    """theory.md eq. 4.8c, its arming: the sliding block (a = g (sin θ − μ cos θ) unscaled) with the
+    release disarmed (inertiaScaleRelease = inf) keeps α = 10 and slides at a/α (the scaled inertia,
+    1% — the elastic start's share); armed in place after 0.05 s (0.1, set on the running engine) α
+    returns to 1 in the next O.dt without rebuilding the solver (solverSteps keeps counting), and
+    from then on the block gains a per second (Coulomb's unscaled slide, 2%)."""
+    engine, speed, a = sliding_block(float("inf"))
     O.run(50, True)
     assert engine.inertiaScale == 10 and engine.inertiaScaleReleaseTime == -1
     assert speed() == pytest.approx(a / 10 * O.time, rel=0.01)
