@@ -7,11 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 #include <cstring>
 #include <limits>
 #include <sstream>
 #include <type_traits>
+#include <utility>
 
 namespace mpm {
 
