@@ -19,6 +19,7 @@ struct PointFieldNames {
 	const char* deformationGradient = "deformationGradient";
 	const char* effectiveStress     = "effectiveStress";
 	const char* externalForce       = "externalForce";
+	const char* volume              = "volume";
 };
 
 // One point's 1D stencil weights along x, y, z. Its constructor leaves them unset, so that

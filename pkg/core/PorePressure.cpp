@@ -230,11 +230,16 @@ namespace stages {
 		for (std::size_t p = 0; p < count; ++p) P.porePressure[p] += dt * pressureRate[p];
 	}
 
-	void updateWaterVolume(const std::vector<Real>& waterDivergence, WaterPointSet& P, Real dt)
+	long updateWaterVolume(const std::vector<Real>& waterDivergence, WaterPointSet& P, Real dt)
 	{
 		const std::size_t count = P.size();
-#pragma omp parallel for schedule(static) if(count > parallelThreshold)
-		for (std::size_t p = 0; p < count; ++p) P.volume[p] *= 1 + dt * waterDivergence[p];
+		long              firstEmptied = static_cast<long>(count);
+#pragma omp parallel for schedule(static) reduction(min : firstEmptied) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) {
+			P.volume[p] *= 1 + dt * waterDivergence[p];
+			if (!(P.volume[p] > 0) || !std::isfinite(P.volume[p])) firstEmptied = std::min(firstEmptied, static_cast<long>(p));
+		}
+		return firstEmptied < static_cast<long>(count) ? firstEmptied : -1;
 	}
 
 	void fillPoresNextToInflowFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const WaterParameters& water, WaterPointSet& P)

@@ -12,7 +12,7 @@ namespace mpm {
 namespace stages {
 	using namespace detail;
 
-	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, const std::vector<Real>* softeningStrain,
+	long updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, const std::vector<Real>* softeningStrain,
 	                       SolidSet& set, Real dt)
 	{
 		SolidPointSet&    P      = *set.points;
@@ -20,7 +20,8 @@ namespace stages {
 		const Real        lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), shear = E / (2 * (1 + nu)), bulk = lambda + 2 * shear / 3;
 		const bool        plastic = set.model != SkeletonModel::LinearElastic, mohrCoulomb = set.model == SkeletonModel::MohrCoulomb;
 		const std::size_t count  = P.size();
-#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		long              firstInverted = static_cast<long>(count);
+#pragma omp parallel for schedule(static) reduction(min : firstInverted) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			const Mat3& L    = velocityGradients[p];
 			Mat3        d    = 0.5 * (L + L.transpose());
@@ -32,6 +33,8 @@ namespace stages {
 			Mat3&      F  = P.deformationGradient[p];
 			F             = dF * F;
 			P.volume[p]   = F.determinant() * P.initialVolume[p]; // eq. 4.14
+			// J ≤ 0: the step turned the point inside out (dt |∇v| ≳ 1); nothing after it has a meaning
+			if (!(P.volume[p] > 0) || !std::isfinite(P.volume[p])) firstInverted = std::min(firstInverted, static_cast<long>(p));
 			const Mat3 sigma = voigtToMatrix(P.effectiveStress[p]);
 			const Mat3 rate  = lambda * d.trace() * Mat3::Identity() + 2 * shear * d; // D^e : d
 			const Mat3 trial = sigma + dt * (spin * sigma - sigma * spin + rate);     // eq. 4.15 (Jaumann)
@@ -46,6 +49,7 @@ namespace stages {
 			}
 			P.porosity[p]        = std::clamp<Real>(1 - (1 - P.porosity[p]) / dJ, 1e-5, 1 - 1e-5); // eq. 1.1
 		}
+		return firstInverted < static_cast<long>(count) ? firstInverted : -1;
 	}
 
 } // namespace stages

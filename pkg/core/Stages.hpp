@@ -244,7 +244,8 @@ namespace stages {
 	// stress, return mapping of the set's skeleton model, porosity; `volumetricRate` (one per
 	// point) replaces tr d when given (cell-averaged volumetric strain rate, B-bar); `softeningStrain`
 	// (one per point) is the κ the friction is taken at (eq. 7.1c) when given, else the point's own κ.
-	void updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, const std::vector<Real>* softeningStrain,
+	// Returns the first point whose volume left (0, ∞) (J = det F ≤ 0: inverted), else −1.
+	long updateSolidStress(const std::vector<Mat3>& velocityGradients, const std::vector<Real>* volumetricRate, const std::vector<Real>* softeningStrain,
 	                       SolidSet& set, Real dt);
 
 	// The Gaussian average w(r) = exp(−|r|²/l²) is truncated at |r_d| ≤ nonlocalTruncation l per axis.
@@ -271,7 +272,8 @@ namespace stages {
 	// V^full_I the node's in-domain support volume. 1 inside the soil, ½ on its surface, 0 outside.
 	Real skeletonFilling(const GridGeometry& grid, const GridFields& fields, const Vec3& position);
 	// Advance the water points' volume with the (possibly cell-averaged) divergence: V ← V (1 + Δt ∇·v^w).
-	void updateWaterVolume(const std::vector<Real>& waterDivergence, WaterPointSet& points, Real dt);
+	// Returns the first point whose volume left (0, ∞) (Δt ∇·v^w ≤ −1), else −1.
+	long updateWaterVolume(const std::vector<Real>& waterDivergence, WaterPointSet& points, Real dt);
 	// Semi-implicit step, next to an inflow face (theory.md eq. 8.9c): the water points whose centre lies
 	// within one cell of a face with waterInflow take the volume of the state, V = m/(n ρw (1 + p/Kw)),
 	// n the step's porosity at the point; the face's nodes keep no volume balance, so there the rate form

@@ -786,8 +786,20 @@ void TwoPhaseSolver::updateSkeleton(Real dt)
 		const SolidSet& set      = solids_[s];
 		const bool      nonlocal = set.model != SkeletonModel::LinearElastic && set.strength.nonlocal();
 		if (nonlocal) stages::nonlocalPlasticStrain(grid_, *set.points, set.strength, softeningStrain_, nonlocalScratch_); // eq. 7.1c
-		stages::updateSolidStress(skeletonGradients_[s], average ? &skeletonVolumetric_[s] : nullptr, nonlocal ? &softeningStrain_ : nullptr, solids_[s], dt);
+		const long inverted =
+		        stages::updateSolidStress(skeletonGradients_[s], average ? &skeletonVolumetric_[s] : nullptr, nonlocal ? &softeningStrain_ : nullptr, solids_[s], dt);
+		if (inverted >= 0) throwVolumeLost(*set.points, set.name, inverted, "the skeleton's deformation gradient turned it inside out (J = det F ≤ 0)", dt);
 	}
+}
+
+void TwoPhaseSolver::throwVolumeLost(const MaterialPointSet& points, const std::string& name, long point, const char* what, Real dt) const
+{
+	std::ostringstream msg;
+	msg << "unstable in solver step " << steps_ << ": " << name << "." << fieldNames_.volume << "[" << point << "] = " << points.volume[point] << " m³ at "
+	    << fieldNames_.position << " " << shown(points.position[point]) << " m, " << fieldNames_.velocity << " " << shown(points.velocity[point])
+	    << " m s⁻¹: " << what << " in one step of " << dt << " s: the grid velocity closes by about a cell (" << grid_.cellSize
+	    << " m) per step across it, Δt |∇v| ≥ 1 (reduce O.dt or timeStepFactor, or check the boundary conditions there)";
+	throw InstabilityError(msg.str());
 }
 
 template <class Kernel> void TwoPhaseSolver::updateWater(Real dt, bool semiImplicit)
@@ -795,7 +807,8 @@ template <class Kernel> void TwoPhaseSolver::updateWater(Real dt, bool semiImpli
 	using namespace stages;
 	StageTimer t(stageSeconds_, Stage::UpdatePorePressure);
 	const bool average = settings_.cellAveragedVolumetricRate;
-	for (WaterPointSet* w : waters_) {
+	for (std::size_t set = 0; set < waters_.size(); ++set) {
+		WaterPointSet* w = waters_[set];
 		// semi-implicit: the pressure was advanced by the projection (eq. 8.8); only the volume moves here
 		computePressureRates<Kernel>(grid_, fields_.solidVelocityNew, fields_.waterVelocityNew, *w, water_, semiImplicit ? nullptr : &pressureRate_,
 		                             waterDivergence_);
@@ -805,7 +818,8 @@ template <class Kernel> void TwoPhaseSolver::updateWater(Real dt, bool semiImpli
 			averageOverCells(cellBins_, *w, waterDivergence_, cellSum_, cellVolume_);
 		}
 		if (!semiImplicit) updatePorePressure(pressureRate_, *w, dt);
-		updateWaterVolume(waterDivergence_, *w, dt);
+		const long emptied = updateWaterVolume(waterDivergence_, *w, dt);
+		if (emptied >= 0) throwVolumeLost(*w, waterNames_[set], emptied, "the water's divergence emptied it (Δt ∇·v^w ≤ −1)", dt);
 		if (semiImplicit) fillPoresNextToInflowFaces(grid_, domain_.boundaries, water_, *w); // eq. 8.9c
 		// semi-implicit: the points carry the interpolated solution, which holds the faces and the
 		// free surface at their nodes (theory.md §8.5); explicit: relaxations and resets (eqs. 4.17b–c, 2.1, 2.3)

@@ -181,6 +181,8 @@ private:
 	void                         updateSkeleton(Real dt);
 	template <class Kernel> void updateWater(Real dt, bool semiImplicit);
 	void                         updateDomains();
+	// A point whose volume left (0, ∞) in the step: InstabilityError naming the set, the point and `what`.
+	[[noreturn]] void throwVolumeLost(const MaterialPointSet& points, const std::string& name, long point, const char* what, Real dt) const;
 	// A point whose stencil leaves the grid: bad input at `setup` (InvalidParameter), else InstabilityError.
 	void                         throwIfOutsideGrid(bool setup) const;
 

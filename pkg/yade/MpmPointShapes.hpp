@@ -13,7 +13,7 @@ namespace yade_mpm {
 
 // The Python names of the point arrays that differ from the core's members; messages from the core
 // use them (TwoPhaseSolver::setFieldNames).
-inline const mpm::PointFieldNames pointFieldNames { "pos", "vel", "defGrad", "stress", "extForce" };
+inline const mpm::PointFieldNames pointFieldNames { "pos", "vel", "defGrad", "stress", "extForce", "volume" };
 
 class MpmSolidPoints : public yade::Shape {
 public:

@@ -310,3 +310,33 @@ TEST(InflowFacePores, PointsWithinACellOfAnInflowFaceTakeTheStateVolume)
 }
 
 } // namespace
+
+namespace {
+
+// Eq. 4.14 and the water's V ← V (1 + Δt ∇·v^w): a step with Δt |∇v| ≥ 1 along one axis leaves
+// J = det F ≤ 0 (or V ≤ 0); the stages report the first such point so the solver stops there
+// (InstabilityError) instead of carrying a negative volume on; an ordinary step reports none.
+TEST(VolumeUpdate, StagesReportTheFirstPointWhoseVolumeLeavesThePositiveRange)
+{
+	const Real            dt      = 1e-3;
+	const auto            lattice = fixtures::lattice(Vec3(0, 0, 0), Vec3(0.2, 0.2, 0.2), 0.1, 2);
+	SolidPointSet         s       = fixtures::solidLattice(lattice, 0.4, 2650);
+	SoilParameters        soil;
+	std::vector<SolidSet> solids { SolidSet { &s, soil } };
+	std::vector<Mat3>     L(s.size(), Mat3::Zero());
+	L[5](2, 2) = -0.5 / dt; // halves the volume: still positive
+	EXPECT_EQ(stages::updateSolidStress(L, nullptr, nullptr, solids[0], dt), -1);
+	EXPECT_NEAR(s.volume[5], 0.5 * s.initialVolume[5], 1e-15);
+	L.assign(s.size(), Mat3::Zero());
+	L[9](2, 2) = L[4](0, 0) = -1.5 / dt; // both turned inside out: the first is named
+	EXPECT_EQ(stages::updateSolidStress(L, nullptr, nullptr, solids[0], dt), 4);
+	EXPECT_LT(s.volume[4], 0);
+
+	WaterPointSet     w = fixtures::waterLattice(lattice, 0.4, 1000);
+	std::vector<Real> divergence(w.size(), -0.5 / dt);
+	EXPECT_EQ(stages::updateWaterVolume(divergence, w, dt), -1);
+	divergence[7] = -1 / dt; // empties it exactly
+	EXPECT_EQ(stages::updateWaterVolume(divergence, w, dt), 7);
+}
+
+} // namespace
