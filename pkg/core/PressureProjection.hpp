@@ -39,7 +39,9 @@ struct PressureSolveReport {
 	std::size_t unknowns   = 0; // free pressure nodes [-]
 	std::size_t fixed      = 0; // nodes with a prescribed pressure (drained and free faces, free surface) [-]
 	long        iterations = 0; // conjugate-gradient iterations [-]
-	Real        residual   = 0; // ‖r‖₂ / mean K_JJ at the end: a pressure [Pa]
+	Real        residual   = 0; // max_J |r_J|/K_JJ at the end: a pressure [Pa]
+	int         rounds     = 0; // solves in the step: 1, or the capillary surface's active set's rounds (eq. 8.5e) [-]
+	bool        settled    = true; // false: that set still changed after its last round [-]
 };
 
 // Quadratic forms of the compact and the exact projection operators for one pressure field.
@@ -102,6 +104,8 @@ struct PressureSystem {
 	};
 	std::vector<std::array<SurfaceCoupling, 125>> surfaceCoupling; // meniscusPairs' scratch, kept from step to step
 	std::vector<Vec3>                             grainResponse[2]; // (same): Δt M⁻¹ on the grains for a unit force on the grains, on the water
+	std::vector<Vec3>                             waterResponse[2]; // (same): on the water
+	std::vector<Real>                             sampledSupport;   // (same): V^w_I = Σ_wp V S_I per node with surface terms [m³]
 	std::vector<FreePair> pairScratch;                              // buildPressureMatrix's scratch, kept from step to step
 	std::vector<int>      rowCount, cursorScratch, columnScratch; // (same)
 	std::vector<Real>     valueScratch;                           // (same)
@@ -176,9 +180,10 @@ namespace stages {
 
 	// Solve eq. 8.7 for the free nodal pressures with Eigen's conjugate gradient,
 	// Jacobi-preconditioned, warm-started from the last step's pressures; stops when
-	// ‖r‖₂ ≤ tolerance × mean K_JJ: the residual of a pressure error `tolerance` [Pa] at a typical node,
-	// the same meaning at every permeability and load (theory.md §8.7). Throws InstabilityError when
-	// it does not converge.
+	// ‖r‖₂ ≤ tolerance × mean K_JJ (the residual of a pressure error `tolerance` [Pa] at a typical node,
+	// the same meaning at every permeability and load, theory.md §8.7), then solves on from there, up
+	// to four times, until |r_J|/K_JJ ≤ tolerance at every node. Throws InstabilityError when the
+	// conjugate gradient does not converge.
 	PressureSolveReport solvePressure(PressureSystem& system, Real tolerance);
 
 	// Defect correction towards the exact projection (theory.md §8.7b): `corrections` times,

@@ -525,10 +525,10 @@ void TwoPhaseSolver::integrateMomentum(Real dt, bool wet, bool semiImplicit)
 	if (!constrained_.plate.empty()) moveRigidPlate(fields_, constrained_, dt, solidMassTolerance_, waterMassTolerance_, plate_); // eq. 2.9
 }
 
-// Eq. 8.5e: the soil's surface nodes hold suction (free unknowns, K with the meniscus force's surface
-// terms) while the solve gives them p ≤ 0; one with p > 0 becomes a seepage-face node (p = 0, or tied as
-// eq. 8.5b), one of those that would draw water in is held again, and the system is solved again until
-// the set no longer changes.
+// Eqs. 8.5e–f: the soil's surface nodes hold suction (free unknowns; K, positive definite, with the
+// meniscus force's surface terms) while the solve leaves the surface there at p ≤ 0; one that does not
+// becomes a seepage-face node (p = 0 at the surface: at the node, or tied as eq. 8.5b), one of those that
+// would draw water in is held again, and the system is solved again until the set no longer changes.
 template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt)
 {
 	// the active set's rounds per step: each changes at least one node, and a surface has few; a set
@@ -550,7 +550,13 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		candidate[r] = sys.surface[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_ && full > 0 &&
 		               fields_.water[sys.node[r]].volume >= heldSurfaceFilling * full;
 	}
+	// the active set starts where the last step's ended (a node new to the surface starts held): with K
+	// positive definite (eq. 8.5f) the Signorini state is unique, so the start changes only how many
+	// rounds it takes to reach it (mostly one)
 	std::vector<char> held = candidate;
+	activeSetState_.resize(grid_.nodeCount(), -1);
+	for (std::size_t r = 0; r < active; ++r)
+		if (candidate[r] && activeSetState_[sys.node[r]] == 0) held[r] = 0;
 	// the surface term Σ_IJ reaches the free nodes next to them too (their supports cross the surface)
 	std::vector<char> withTerms = candidate;
 	{
@@ -577,9 +583,7 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	const std::vector<Real> value0 = sys.fixedValue;
 	const std::vector<int>  master0 = sys.ghostMaster;
 	// many owners share a pair of nodes (~10⁵ shares on ~10³ pairs): the pairs are numbered once per
-	// step (shares bucketed by row, then by column with a per-node mark: O(shares + nodes)) and the
-	// shares of the free nodes next to the held ones, which count in every round, summed once; a round
-	// adds the shares of the candidates it holds
+	// step (shares bucketed by row, then by column with a per-node mark: O(shares + nodes)) and summed
 	std::vector<PressureSystem::NodePair>& nodePairs = meniscusNodePairs_;
 	std::vector<std::size_t>&              pairOf    = meniscusPairOf_;
 	{
@@ -604,20 +608,16 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 				pairOf[t] = mark[c];
 			}
 		}
-		order.clear(); // from here: the candidates' shares
-		for (std::size_t t = 0; t < terms.size(); ++t) {
-			if (candidate[terms[t].owner]) order.push_back(t);
-			else nodePairs[pairOf[t]].value += terms[t].pair.value;
-		}
+		for (std::size_t t = 0; t < terms.size(); ++t) nodePairs[pairOf[t]].value += terms[t].pair.value;
 	}
-	const std::vector<std::size_t>& candidateShares = meniscusScratch_[1];
+	sys.extraPairs.assign(nodePairs.begin(), nodePairs.end());
 	lastPressureSolve_ = PressureSolveReport {};
+	std::vector<char> oneRoundBack = held, twoRoundsBack;
+	bool              oneAtATime   = false;
 	for (int round = 0; round < maxSeepageRounds; ++round) {
-		// a held node is a free unknown with its surface terms; a released one is a seepage-face node as
-		// classified (p = 0, or tied by eq. 8.5b), its terms dropped
-		sys.extraPairs.assign(nodePairs.begin(), nodePairs.end());
-		for (const std::size_t t : candidateShares)
-			if (held[terms[t].owner]) sys.extraPairs[pairOf[t]].value += terms[t].pair.value;
+		// a held node is a free unknown; a released one is a seepage-face node as classified (p = 0, or
+		// tied by eq. 8.5b). K, surface terms included, is the same in every round: the rounds solve one
+		// convex quadratic programme with the surface's pressure ≤ 0 as its constraints (eq. 8.5f)
 		for (std::size_t r = 0; r < active; ++r) {
 			const bool free = held[r];
 			sys.fixed[r]      = free ? 0 : fixed0[r];
@@ -630,6 +630,7 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		}
 		StageTimer t(stageSeconds_, Stage::SolvePressure);
 		const PressureSolveReport report = solvePressure(sys, settings_.pressureTolerance);
+		lastPressureSolve_.rounds = round + 1;
 		lastPressureSolve_.iterations += report.iterations;
 		lastPressureSolve_.unknowns = report.unknowns, lastPressureSolve_.fixed = report.fixed, lastPressureSolve_.residual = report.residual;
 		if (settings_.pressureCorrections > 0) {
@@ -638,18 +639,36 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 			                                                               settings_.pressureTolerance, static_cast<int>(settings_.pressureCorrections), sys);
 			lastPressureSolve_.iterations += more.iterations;
 		}
-		// Signorini's conditions on the seepage face: a held node (no flux) must hold p ≤ 0, a released
-		// one (p = 0) must let water out, not draw it in — its row's excess b − K p, the volume rate its
-		// tent sheds through the boundary, > 0
+		// Signorini's conditions on the seepage face, at the surface itself: a held node (no flux) must
+		// leave the surface in suction, p ≤ 0 there; a released one (p = 0 there) must let water out, not
+		// draw it in — its row's excess b − K p, the volume rate its tent sheds through the boundary, > 0.
+		// Released, a node tied by eq. 8.5b reads p_I = c p_J, which puts p = 0 at the surface; held, the
+		// surface lies in suction while p_I ≤ c p_J (p linear from J through I). Compared with p_I ≤ 0
+		// instead, a node inside the water (0 < c < 1) held at 0 < p_I < c p_J was released, then drew
+		// water in and was held again, twenty rounds on (theory.md eq. 8.5e).
+		// All the nodes that break them switch at once; should that return to the set of two rounds back
+		// (two neighbours taking turns), from then on only the first that breaks them switches per round:
+		// Murty's least-index rule, which ends for any start where the constraints' matrix is a P-matrix
+		// (K positive definite, eq. 8.5f)
 		const std::vector<Real> excess = rowExcess(grid_, sys);
 		bool changed = false;
-		for (std::size_t r = 0; r < active; ++r) {
+		for (std::size_t r = 0; r < active && !(changed && oneAtATime); ++r) {
 			if (!candidate[r]) continue;
-			if (held[r] && sys.nodalPressure[sys.node[r]] > 0) held[r] = 0, changed = true;
+			const int  master  = master0.empty() ? -1 : master0[r];
+			const bool tied    = master >= 0 && !sys.fixed[static_cast<std::size_t>(master)]; // as buildPressureMatrix ties it
+			const Real release = tied ? sys.ghostFactor[r] * sys.nodalPressure[sys.node[static_cast<std::size_t>(master)]] : value0[r];
+			if (held[r] && sys.nodalPressure[sys.node[r]] > release) held[r] = 0, changed = true;
 			else if (!held[r] && excess[r] < 0) held[r] = 1, changed = true;
 		}
 		if (!changed) break;
+		oneAtATime = oneAtATime || held == twoRoundsBack;
+		twoRoundsBack.swap(oneRoundBack);
+		oneRoundBack = held;
+		if (round + 1 == maxSeepageRounds) lastPressureSolve_.settled = false, ++unsettledActiveSets_;
 	}
+	std::fill(activeSetState_.begin(), activeSetState_.end(), -1);
+	for (std::size_t r = 0; r < active; ++r)
+		if (candidate[r]) activeSetState_[sys.node[r]] = static_cast<signed char>(held[r]);
 	sys.extraPairs.clear(); // this step's; the other paths build K without them
 }
 

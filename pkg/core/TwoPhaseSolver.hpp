@@ -126,6 +126,8 @@ public:
 	const GridGeometry&                                 grid() const { return grid_; }
 	// The last semi-implicit pressure solve (zeros before the first one or with the explicit scheme).
 	const PressureSolveReport&                          lastPressureSolve() const { return lastPressureSolve_; }
+	// Steps since setup whose capillary surface's active set still changed after its last round (eq. 8.5e).
+	long                                                unsettledActiveSets() const { return unsettledActiveSets_; }
 	const PressureSystem&                               pressureSystem() const { return pressureSystem_; } // the last step's (tests, diagnostics)
 	const GridFields&                                   fields() const { return fields_; }
 	// The inertia scale in force (eq. 4.8b): settings().inertiaScale until the release of eq. 4.8c, 1 after it.
@@ -236,6 +238,8 @@ private:
 	PressureModeScratch           pressureModes_; // scratch of eqs. 4.17b–c
 	PressureSystem                pressureSystem_; // eq. 8.7 and its scratch
 	PressureSolveReport           lastPressureSolve_ {};
+	long                          unsettledActiveSets_ = 0;
+	std::vector<signed char>      activeSetState_; // per grid node, the last step's capillary surface (eq. 8.5e): −1 not a candidate, 0 released, 1 held
 	std::vector<std::array<bool, 3>> heldSolid_; // per constrained node: solid components held this step
 	Real                          pressureDiffusivity_ = 0; // c_v [m² s⁻¹] of eq. 4.17b
 	Real                          inertiaScale_        = 1;  // α in force (eq. 4.8b)
