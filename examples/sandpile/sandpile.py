@@ -407,7 +407,7 @@ lem_onset, lem_deep_onset, lem_deep_peak_onset = lem_crossing(2), lem_crossing(3
 lem_summary = {"method": "Bishop simplified, critical circle (yade_mpm.slope_stability)",
                "strength": "c = 0, Davis (1968) for φ = %.0f°, ψ = %.0f°" % (math.degrees(SCENE.friction_angle), math.degrees(SCENE.dilatancy_angle)),
                "times_s": [r[0] for r in lem_records], "heads_m": [r[1] for r in lem_records],
-               "factors": [r[2].factor for r in lem_records], "onset": lem_onset,
+               "factors": [r[2].factor for r in lem_records], "circles": [r[2].describe() for r in lem_records], "onset": lem_onset,
                "lem_onset_head_m": None if lem_onset is None else lem_onset["head_m"],
                "deep_min_depth_m": DEEP_SLIDE_CELLS * CELL, "deep_factors": [None if r[3] is None else r[3].factor for r in lem_records], "deep_onset": lem_deep_onset,
                "lem_deep_onset_head_m": None if lem_deep_onset is None else lem_deep_onset["head_m"],

@@ -326,6 +326,13 @@ class CriticalCircle:
         order = np.argsort(x)
         return x[order], self.slices.z[order]
 
+    def describe(self):
+        """Where the circle lies, for a summary: its centre (x, z) and radius [m], the span of its
+        slices' base midpoints along x [m] and their lowest elevation [m] (the section's frame)."""
+        x, z = self.surface()
+        return {"factor": float(self.factor), "centre_m": [float(c) for c in self.centre], "radius_m": float(self.radius),
+                "from_x_m": float(x.min()), "to_x_m": float(x.max()), "lowest_z_m": float(z.min())}
+
 
 def _corners(section, min_turn=math.radians(5)):
     """Vertices of the ground polyline where its inclination turns by more than min_turn: a steep

@@ -38,6 +38,13 @@ def test_bishop_critical_circle_meets_taylors_stability_number(slope_deg, taylor
     # a toe circle: it leaves the slope within a few percent of H of the toe
     exit_x = best.surface()[0].max()
     assert abs(exit_x - height / math.tan(math.radians(slope_deg))) < 0.05 * height
+    # the summary's description of it (the sand-pile example records one per evaluation) is the
+    # same circle: its slices' base midpoints lie on it, within the span and above the lowest point given
+    where = best.describe()
+    x, z = best.surface()
+    assert where["factor"] == best.factor and where["radius_m"] == best.radius
+    assert np.allclose(np.hypot(x - where["centre_m"][0], z - where["centre_m"][1]), where["radius_m"], rtol=1e-9)
+    assert (where["from_x_m"], where["to_x_m"], where["lowest_z_m"]) == (x.min(), x.max(), z.min())
 
 
 @pytest.mark.parametrize("cohesion, friction_deg, seepage", [(0.0, 35, False), (0.0, 35, True), (5e3, 25, False), (5e3, 25, True)])
