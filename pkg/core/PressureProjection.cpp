@@ -988,18 +988,25 @@ namespace stages {
 			// and the gradient form's true lumped share less the one L's mobility implies
 			const Vec3 cross     = 0.5 * (sw[I] + ws[I]); // R's off-diagonal: the same both ways up to round-off
 			const Real perVolume = sampled[c] > 0 ? dt / sampled[c] : 0;
+			// value(J, K) = u_Kᵀ Z u_J, u = (Σ_IJ where it counts, (R g)_J on the grains, g^s_J, g^w_J, a_J = −Σ V S_I ∇S_J) per
+			// axis: Σᵀ R_ss Σ + Σᵀ (R g) + (R g)ᵀ Σ (the surface terms), g_Jᵀ R_I g_K, − Δt λ_I a_J a_K / V^w_I
+			std::array<std::array<Real, 15>, 125> u, zu;
 			for (int x = 0; x < m; ++x) {
-				const int       j = reached[x];
-				const Coupling& J = coupling[c][j];
+				const Coupling& J  = coupling[c][reached[x]];
+				const Vec3      Js = surfaced[reached[x]] ? J.surface : Vec3::Zero(), aj = J.solid + J.water;
+				for (int d = 0; d < 3; ++d) {
+					const Real v[5] = { Js[d], onGrains[reached[x]][d], J.solid[d], J.water[d], aj[d] };
+					const Real z[5] = { ss[I][d] * v[0] + v[1], v[0], ss[I][d] * v[2] + cross[d] * v[3], cross[d] * v[2] + ww[I][d] * v[3],
+					                    -perVolume * system.mobility[I][d] * v[4] };
+					for (int e = 0; e < 5; ++e) u[x][5 * d + e] = v[e], zu[x][5 * d + e] = z[e];
+				}
+			}
+			for (int x = 0; x < m; ++x) {
+				const int j = reached[x];
 				for (int y = x; y < m; ++y) {
-					const int       k     = reached[y];
-					const Coupling& K     = coupling[c][k];
-					const Vec3      Js    = surfaced[j] ? J.surface : Vec3::Zero(), Ks = surfaced[k] ? K.surface : Vec3::Zero();
-					const Real      trueLumped = J.solid.dot(ss[I].cwiseProduct(K.solid) + cross.cwiseProduct(K.water)) +
-					                        J.water.dot(cross.cwiseProduct(K.solid) + ww[I].cwiseProduct(K.water)); // g_Jᵀ R_I g_K
-					const Vec3 aj = J.solid + J.water, ak = K.solid + K.water; // −Σ_wp V S_I ∇S_J
-					const Real value = Js.dot(ss[I].cwiseProduct(Ks)) + Js.dot(onGrains[k]) + onGrains[j].dot(Ks) + trueLumped -
-					                   perVolume * aj.dot(system.mobility[I].cwiseProduct(ak));
+					const int k     = reached[y];
+					Real      value = 0;
+					for (int e = 0; e < 15; ++e) value += u[y][e] * zu[x][e];
 					if (value == 0) continue;
 					std::size_t a = static_cast<std::size_t>(rowOf[j]), b = static_cast<std::size_t>(rowOf[k]);
 					if (a > b) std::swap(a, b);
