@@ -885,9 +885,14 @@ namespace stages {
 	template <class Kernel>
 	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, std::vector<WaterPointSet*>& sets, const ConstrainedNodes& constrained,
 	                   const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance,
-	                   const std::vector<char>& candidate, PressureSystem& system, std::vector<MeniscusPair>& pairs)
+	                   const std::vector<char>& candidate, PressureSystem& system, std::vector<PressureSystem::NodePair>& pairs)
 	{
 		pairs.clear();
+		constexpr int blockSlots = 9 * 9 * 9; // the offsets (−4…4)³ from a row's node to its partner's
+		std::vector<Real>& blocks  = system.pairBlocks;
+		std::vector<int>&  blockOf = system.pairBlockOf;
+		blocks.clear();
+		blockOf.assign(system.node.size(), -1);
 		const std::size_t nodes = grid.nodeCount(), active = system.node.size();
 		// the nodal response Δt M⁻¹ per axis (with the walls' holds) to a unit force on the grains and on the water
 		std::vector<Vec3>& ss = system.grainResponse[0];
@@ -1008,10 +1013,23 @@ namespace stages {
 					Real      value = 0;
 					for (int e = 0; e < 15; ++e) value += u[y][e] * zu[x][e];
 					if (value == 0) continue;
-					std::size_t a = static_cast<std::size_t>(rowOf[j]), b = static_cast<std::size_t>(rowOf[k]);
-					if (a > b) std::swap(a, b);
-					pairs.push_back(MeniscusPair { r, PressureSystem::NodePair { a, b, value } });
+					// the row with the smaller index holds the pair, at the partner's offset from it
+					int a = rowOf[j], from = j, to = k;
+					if (rowOf[k] < a) a = rowOf[k], from = k, to = j;
+					if (blockOf[a] < 0) blockOf[a] = static_cast<int>(blocks.size() / blockSlots), blocks.resize(blocks.size() + blockSlots, 0);
+					const int slot = (to / 25 - from / 25 + 4) * 81 + ((to / 5) % 5 - (from / 5) % 5 + 4) * 9 + (to % 5 - from % 5 + 4);
+					blocks[static_cast<std::size_t>(blockOf[a]) * blockSlots + slot] += value;
 				}
+			}
+		}
+		for (std::size_t a = 0; a < system.node.size(); ++a) {
+			if (blockOf[a] < 0) continue;
+			const Real*              block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots;
+			const std::array<int, 3> ia    = grid.indices(system.node[a]);
+			for (int slot = 0; slot < blockSlots; ++slot) {
+				if (block[slot] == 0) continue;
+				const int b = system.row[grid.index(ia[0] + slot % 9 - 4, ia[1] + (slot / 9) % 9 - 4, ia[2] + slot / 81 - 4)];
+				pairs.push_back(PressureSystem::NodePair { a, static_cast<std::size_t>(b), block[slot] });
 			}
 		}
 	}
@@ -1198,7 +1216,7 @@ namespace stages {
 	                                                     Real, Real, int, PressureSystem&);                                                          \
 	template void meniscusPairs<K>(const GridGeometry&, const GridFields&, std::vector<WaterPointSet*>&, const ConstrainedNodes&,                   \
 	                               const std::vector<std::array<bool, 3>>&, Real, Real, Real, const std::vector<char>&, PressureSystem&,          \
-	                               std::vector<MeniscusPair>&);                                                                                      \
+	                               std::vector<PressureSystem::NodePair>&);                                                                                      \
 	template ProjectionForms projectionForms<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&, \
 	                                            const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,                \
 	                                            const std::vector<Real>&, PressureSystem&);                                                          \

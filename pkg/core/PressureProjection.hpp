@@ -106,6 +106,8 @@ struct PressureSystem {
 	std::vector<Vec3>                             grainResponse[2]; // (same): Δt M⁻¹ on the grains for a unit force on the grains, on the water
 	std::vector<Vec3>                             waterResponse[2]; // (same): on the water
 	std::vector<Real>                             sampledSupport;   // (same): V^w_I = Σ_wp V S_I per node with surface terms [m³]
+	std::vector<Real>                             pairBlocks;       // (same): per row they reach, its pairs by offset (9³ slots)
+	std::vector<int>                              pairBlockOf;      // (same): per row, its block in pairBlocks, −1: none
 	std::vector<FreePair> pairScratch;                              // buildPressureMatrix's scratch, kept from step to step
 	std::vector<int>      rowCount, cursorScratch, columnScratch; // (same)
 	std::vector<Real>     valueScratch;                           // (same)
@@ -153,20 +155,17 @@ namespace stages {
 	// one the volume rate its tent must shed through the boundary [m³ s⁻¹].
 	std::vector<Real> rowExcess(const GridGeometry& grid, const PressureSystem& system);
 
-	// The held surface's terms of K (theory.md eq. 8.5e): for each pressure node I with `candidate` set,
-	// Δt [f_Jᵀ M_I⁻¹ f_K − g_Jᵀ M_I⁻¹ g_K] for every pair of nodes J ≤ K its water points reach, where
+	// The surface nodes' terms of K (theory.md eqs. 8.5e–f): for each pressure node I with `candidate`
+	// set and every pair of nodes J ≤ K its water points reach, Δt [f_Jᵀ M_I⁻¹ f_K − λ_I a_J a_K/V^w_I], where
 	// g_J = (−Σ_wp V (1 − n) S_I ∇S_J, −Σ_wp V n S_I ∇S_J) is the force at I of a unit pressure at J in the
-	// gradient form the compact L condenses (grains, water), f_J = g_J + (Σ_IJ, 0) adds the surface term
-	// Σ_IJ = Σ_wp V ∇(S_I S_J) on the grains (the meniscus force; zero where I's support lies inside
-	// the soil), and M_I⁻¹ is the nodal 2×2 system with the walls' holds (eq. 8.8). `owner` is I.
-	struct MeniscusPair {
-		std::size_t              owner;
-		PressureSystem::NodePair pair;
-	};
+	// gradient form (grains, water), f_J = g_J + (Σ_IJ, 0) adds the surface term Σ_IJ = Σ_wp V ∇(S_I S_J) on
+	// the grains (the meniscus force; zero where I's support lies inside the soil), M_I⁻¹ is the nodal 2×2
+	// system with the walls' holds (eq. 8.8), a_J = Σ_wp V S_I ∇S_J and V^w_I = Σ_wp V S_I: summed over I into
+	// one entry per pair of rows (row ≤ column), in the order of the rows, each row's by offset.
 	template <class Kernel>
 	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, std::vector<WaterPointSet*>& sets, const ConstrainedNodes& constrained,
 	                   const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance,
-	                   const std::vector<char>& candidate, PressureSystem& system, std::vector<MeniscusPair>& pairs);
+	                   const std::vector<char>& candidate, PressureSystem& system, std::vector<PressureSystem::NodePair>& pairs);
 
 	// The rigid plate's column of B (theory.md eq. 2.9): b_J = Σ_wp V n D S_J + Σ_sp V (1 − n) D S_J with
 	// D = Σ_{I ∈ plate} ∂S_I/∂x_axis at the point, and c = Δt/M; K of eq. 8.7 gains c b bᵀ.

@@ -574,43 +574,13 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		for (std::size_t r = 0; r < active; ++r)
 			withTerms[r] = withTerms[r] || (near[sys.node[r]] && !sys.fixed[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_);
 	}
-	std::vector<MeniscusPair>& terms = meniscusPairs_;
 	{
-		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eq. 8.5e
-		meniscusPairs<Kernel>(grid_, fields_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, withTerms, sys, terms);
+		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.5e–f, one entry per pair of rows
+		meniscusPairs<Kernel>(grid_, fields_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, withTerms, sys, sys.extraPairs);
 	}
-	const std::vector<char> fixed0 = sys.fixed;
-	const std::vector<Real> value0 = sys.fixedValue;
+	const std::vector<char> fixed0  = sys.fixed;
+	const std::vector<Real> value0  = sys.fixedValue;
 	const std::vector<int>  master0 = sys.ghostMaster;
-	// many owners share a pair of nodes (~10⁵ shares on ~10³ pairs): the pairs are numbered once per
-	// step (shares bucketed by row, then by column with a per-node mark: O(shares + nodes)) and summed
-	std::vector<PressureSystem::NodePair>& nodePairs = meniscusNodePairs_;
-	std::vector<std::size_t>&              pairOf    = meniscusPairOf_;
-	{
-		std::vector<std::size_t>& start = meniscusScratch_[0];
-		std::vector<std::size_t>& order = meniscusScratch_[1];
-		std::vector<std::size_t>& mark  = meniscusScratch_[2];
-		start.assign(active + 1, 0);
-		for (const MeniscusPair& e : terms) ++start[e.pair.row + 1];
-		for (std::size_t r = 0; r < active; ++r) start[r + 1] += start[r];
-		order.resize(terms.size());
-		for (std::size_t t = 0; t < terms.size(); ++t) order[start[terms[t].pair.row]++] = t; // start[r] ends at row r + 1's start
-		mark.assign(active, std::numeric_limits<std::size_t>::max()); // the pair index of (row, column) for the row being visited
-		nodePairs.clear();
-		pairOf.resize(terms.size());
-		std::size_t from = 0;
-		for (std::size_t r = 0; r < active; ++r) {
-			const std::size_t first = nodePairs.size();
-			for (; from < start[r]; ++from) {
-				const std::size_t t = order[from], c = terms[t].pair.column;
-				if (mark[c] == std::numeric_limits<std::size_t>::max() || mark[c] < first)
-					mark[c] = nodePairs.size(), nodePairs.push_back(PressureSystem::NodePair { r, c, 0 });
-				pairOf[t] = mark[c];
-			}
-		}
-		for (std::size_t t = 0; t < terms.size(); ++t) nodePairs[pairOf[t]].value += terms[t].pair.value;
-	}
-	sys.extraPairs.assign(nodePairs.begin(), nodePairs.end());
 	lastPressureSolve_ = PressureSolveReport {};
 	std::vector<char> oneRoundBack = held, twoRoundsBack;
 	bool              oneAtATime   = false;

@@ -173,10 +173,6 @@ private:
 	void                         integrateMomentum(Real dt, bool wet, bool semiImplicit);
 	template <class Kernel> void projectPressure(Real dt);
 	template <class Kernel> void projectWithCapillarySurface(Real dt);
-	std::vector<stages::MeniscusPair>          meniscusPairs_;       // eq. 8.5e's node-pair shares, kept from step to step
-	std::vector<PressureSystem::NodePair>      meniscusNodePairs_;   // (same): the distinct pairs of nodes they fall on
-	std::vector<std::size_t>                   meniscusPairOf_;      // (same): per share, its entry in meniscusNodePairs_
-	std::vector<std::size_t>                   meniscusScratch_[3];  // (same): bucket starts, order by row, per-node marks
 	template <class Kernel> void movePoints(Real dt);
 	template <class Kernel> void skeletonRates();
 	template <class Kernel> void remap(bool wet, bool solid);
