@@ -41,7 +41,6 @@ struct PressureSolveReport {
 	long        iterations = 0; // conjugate-gradient iterations [-]
 	Real        residual   = 0; // max_J |r_J|/K_JJ at the end: a pressure [Pa]
 	int         rounds     = 0; // solves in the step: 1, or the capillary surface's active set's rounds (eq. 8.5e) [-]
-	bool        settled    = true; // false: that set still changed after its last round [-]
 };
 
 // Quadratic forms of the compact and the exact projection operators for one pressure field.

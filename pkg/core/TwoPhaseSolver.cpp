@@ -553,10 +553,10 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	// the active set starts where the last step's ended (a node new to the surface starts held): with K
 	// positive definite (eq. 8.5f) the Signorini state is unique, so the start changes only how many
 	// rounds it takes to reach it (mostly one)
-	std::vector<char> held = candidate;
-	activeSetState_.resize(grid_.nodeCount(), -1);
-	for (std::size_t r = 0; r < active; ++r)
-		if (candidate[r] && activeSetState_[sys.node[r]] == 0) held[r] = 0;
+	std::vector<char>& released = releasedSurface_; // per grid node
+	released.resize(grid_.nodeCount(), 0);
+	std::vector<char> held(active, 0);
+	for (std::size_t r = 0; r < active; ++r) held[r] = candidate[r] && !released[sys.node[r]];
 	// the surface term Σ_IJ reaches the free nodes next to them too (their supports cross the surface)
 	std::vector<char> withTerms = candidate;
 	{
@@ -634,11 +634,10 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		oneAtATime = oneAtATime || held == twoRoundsBack;
 		twoRoundsBack.swap(oneRoundBack);
 		oneRoundBack = held;
-		if (round + 1 == maxSeepageRounds) lastPressureSolve_.settled = false, ++unsettledActiveSets_;
+		if (round + 1 == maxSeepageRounds) ++unsettledActiveSets_;
 	}
-	std::fill(activeSetState_.begin(), activeSetState_.end(), -1);
-	for (std::size_t r = 0; r < active; ++r)
-		if (candidate[r]) activeSetState_[sys.node[r]] = static_cast<signed char>(held[r]);
+	std::fill(released.begin(), released.end(), 0);
+	for (std::size_t r = 0; r < active; ++r) released[sys.node[r]] = candidate[r] && !held[r];
 	sys.extraPairs.clear(); // this step's; the other paths build K without them
 }
 

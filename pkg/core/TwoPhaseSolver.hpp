@@ -235,7 +235,7 @@ private:
 	PressureSystem                pressureSystem_; // eq. 8.7 and its scratch
 	PressureSolveReport           lastPressureSolve_ {};
 	long                          unsettledActiveSets_ = 0;
-	std::vector<signed char>      activeSetState_; // per grid node, the last step's capillary surface (eq. 8.5e): −1 not a candidate, 0 released, 1 held
+	std::vector<char>             releasedSurface_; // per grid node: a surface node released (seepage face) in the last step (eq. 8.5f)
 	std::vector<std::array<bool, 3>> heldSolid_; // per constrained node: solid components held this step
 	Real                          pressureDiffusivity_ = 0; // c_v [m² s⁻¹] of eq. 4.17b
 	Real                          inertiaScale_        = 1;  // α in force (eq. 4.8b)
