@@ -881,6 +881,8 @@ namespace stages {
 	// Σ_IJ below this share of node I's largest counts as round-off (eq. 8.5e): the sum over points of
 	// ∇(S_I S_J) over a support inside the soil cancels to the points' quadrature error
 	constexpr Real surfaceShareTolerance = 1e-9;
+	// meniscusPairs shares its surface nodes among the threads from this many on (one costs ≈ 40 µs)
+	constexpr std::size_t parallelSurfaceNodes = 8;
 
 	template <class Kernel>
 	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, std::vector<WaterPointSet*>& sets, const ConstrainedNodes& constrained,
@@ -889,10 +891,6 @@ namespace stages {
 	{
 		pairs.clear();
 		constexpr int blockSlots = 9 * 9 * 9; // the offsets (−4…4)³ from a row's node to its partner's
-		std::vector<Real>& blocks  = system.pairBlocks;
-		std::vector<int>&  blockOf = system.pairBlockOf;
-		blocks.clear();
-		blockOf.assign(system.node.size(), -1);
 		const std::size_t nodes = grid.nodeCount(), active = system.node.size();
 		// the nodal response Δt M⁻¹ per axis (with the walls' holds) to a unit force on the grains and on the water
 		std::vector<Vec3>& ss = system.grainResponse[0];
@@ -925,112 +923,173 @@ namespace stages {
 		std::vector<Real>& sampled = system.sampledSupport; // V^w_I = Σ_wp V S_I, per candidate
 		sampled.assign(candidates.size(), 0);
 		constexpr int S = Kernel::stencil;
-		for (const WaterPointSet* set : sets) {
-			const WaterPointSet& P = *set;
-			for (std::size_t p = 0; p < P.size(); ++p) {
-				Weights1D w[3];
-				weightsAt<Kernel>(grid, P, p, w);
-				std::size_t I[S * S * S];
-				Real        N[S * S * S];
-				Vec3        dN[S * S * S];
-				int         m = 0;
-				bool        touches = false;
-				Real        n = 0;
-				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real NJ, const Vec3& dNJ) {
-					I[m] = J, N[m] = NJ, dN[m] = dNJ, ++m;
-					n += NJ * fields.porosity[J];
-					touches = touches || slotOf[J] >= 0;
-				});
-				if (!touches) continue;
-				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
-				const Real V = P.volume[p];
-				std::array<int, 3> at[S * S * S];
-				for (int a = 0; a < m; ++a) at[a] = grid.indices(I[a]);
-				for (int a = 0; a < m; ++a) {
-					if (slotOf[I[a]] < 0) continue;
-					auto&                     c  = coupling[static_cast<std::size_t>(slotOf[I[a]])];
-					sampled[static_cast<std::size_t>(slotOf[I[a]])] += V * N[a];
-					const std::array<int, 3>& ia = at[a];
-					for (int b = 0; b < m; ++b) {
-						const std::array<int, 3>& ib = at[b];
-						const int dx = ib[0] - ia[0], dy = ib[1] - ia[1], dz = ib[2] - ia[2];
-						if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap (refused at setup)
-						Coupling& e = c[offsetSlot(dx, dy, dz)];
-						e.surface += V * (N[b] * dN[a] + N[a] * dN[b]);
-						e.solid -= V * (1 - n) * N[a] * dN[b];
-						e.water -= V * n * N[a] * dN[b];
+		// thread 0 sums into `coupling` and `sampled`, the others into their own copies, added after in thread order
+		std::size_t waterPoints = 0;
+		for (const WaterPointSet* set : sets) waterPoints += set->size();
+		const int pointThreads = waterPoints <= parallelThreshold ? 1 : omp_get_max_threads();
+		system.surfaceCouplingBuffers.resize(static_cast<std::size_t>(pointThreads - 1));
+		system.sampledSupportBuffers.resize(static_cast<std::size_t>(pointThreads - 1));
+#pragma omp parallel num_threads(pointThreads)
+		{
+			const int tid     = omp_get_thread_num();
+			auto&     mine    = tid == 0 ? coupling : system.surfaceCouplingBuffers[static_cast<std::size_t>(tid - 1)];
+			auto&     myShare = tid == 0 ? sampled : system.sampledSupportBuffers[static_cast<std::size_t>(tid - 1)];
+			if (tid > 0) {
+				mine.resize(candidates.size());
+				for (auto& c : mine) c.fill(Coupling {});
+				myShare.assign(candidates.size(), 0);
+			}
+			for (const WaterPointSet* set : sets) {
+				const WaterPointSet& P = *set;
+#pragma omp for schedule(static)
+				for (std::size_t p = 0; p < P.size(); ++p) {
+					Weights1D w[3];
+					weightsAt<Kernel>(grid, P, p, w);
+					std::size_t I[S * S * S];
+					Real        N[S * S * S];
+					Vec3        dN[S * S * S];
+					int         m       = 0;
+					bool        touches = false;
+					Real        n       = 0;
+					forEachNode<Kernel>(grid, w, [&](std::size_t J, Real NJ, const Vec3& dNJ) {
+						I[m] = J, N[m] = NJ, dN[m] = dNJ, ++m;
+						n += NJ * fields.porosity[J];
+						touches = touches || slotOf[J] >= 0;
+					});
+					if (!touches) continue;
+					n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
+					const Real V = P.volume[p];
+					std::array<int, 3> at[S * S * S];
+					for (int a = 0; a < m; ++a) at[a] = grid.indices(I[a]);
+					for (int a = 0; a < m; ++a) {
+						if (slotOf[I[a]] < 0) continue;
+						auto& c = mine[static_cast<std::size_t>(slotOf[I[a]])];
+						myShare[static_cast<std::size_t>(slotOf[I[a]])] += V * N[a];
+						const std::array<int, 3>& ia = at[a];
+						for (int b = 0; b < m; ++b) {
+							const std::array<int, 3>& ib = at[b];
+							const int dx = ib[0] - ia[0], dy = ib[1] - ia[1], dz = ib[2] - ia[2];
+							if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap (refused at setup)
+							Coupling& e = c[offsetSlot(dx, dy, dz)];
+							e.surface += V * (N[b] * dN[a] + N[a] * dN[b]);
+							e.solid -= V * (1 - n) * N[a] * dN[b];
+							e.water -= V * n * N[a] * dN[b];
+						}
 					}
 				}
 			}
 		}
-		for (std::size_t c = 0; c < candidates.size(); ++c) {
-			const std::size_t        r   = candidates[c];
-			const std::size_t        I   = system.node[r];
-			const std::array<int, 3> idx = grid.indices(I);
-			int                      rowOf[125];
-			for (int o = 0; o < 125; ++o) {
-				rowOf[o]    = -1;
-				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, cc = o / 25 - 2;
-				const int x = idx[0] + a, y = idx[1] + b, z = idx[2] + cc;
-				if (x < 0 || y < 0 || z < 0 || x >= grid.nodes[0] || y >= grid.nodes[1] || z >= grid.nodes[2]) continue;
-				rowOf[o] = system.row[grid.index(x, y, z)];
-			}
-			// (M⁻¹ g_J) on the grains, per J
-			std::array<Vec3, 125> onGrains;
-			for (int o = 0; o < 125; ++o) onGrains[o] = ss[I].cwiseProduct(coupling[c][o].solid) + sw[I].cwiseProduct(coupling[c][o].water);
-			// the surface term of a node J whose product support with I lies inside the soil is round-off
-			// (Σ_IJ → 0); the pairs of such nodes keep the gradient form's part below
-			Real largest = 0;
-			for (int o = 0; o < 125; ++o) largest = std::max(largest, coupling[c][o].surface.norm());
-			if (!(largest > 0)) continue;
-			const Real negligible = surfaceShareTolerance * largest;
-			int        reached[125], surfaced[125], m = 0;
-			for (int o = 0; o < 125; ++o)
-				if (rowOf[o] >= 0) reached[m++] = o;
-			for (int o = 0; o < 125; ++o) surfaced[o] = coupling[c][o].surface.norm() > negligible;
-			// eq. 8.5f: node I's share of K becomes L_I − Δt λ_I a aᵀ/V^w_I + F_Iᵀ R_I F_I (a covariance and a
-			// Gram matrix: K positive definite by construction), i.e. L plus, per pair, the surface terms
-			// and the gradient form's true lumped share less the one L's mobility implies
-			const Vec3 cross     = 0.5 * (sw[I] + ws[I]); // R's off-diagonal: the same both ways up to round-off
-			const Real perVolume = sampled[c] > 0 ? dt / sampled[c] : 0;
-			// value(J, K) = u_Kᵀ Z u_J, u = (Σ_IJ where it counts, (R g)_J on the grains, g^s_J, g^w_J, a_J = −Σ V S_I ∇S_J) per
-			// axis: Σᵀ R_ss Σ + Σᵀ (R g) + (R g)ᵀ Σ (the surface terms), g_Jᵀ R_I g_K, − Δt λ_I a_J a_K / V^w_I
-			std::array<std::array<Real, 15>, 125> u, zu;
-			for (int x = 0; x < m; ++x) {
-				const Coupling& J  = coupling[c][reached[x]];
-				const Vec3      Js = surfaced[reached[x]] ? J.surface : Vec3::Zero(), aj = J.solid + J.water;
-				for (int d = 0; d < 3; ++d) {
-					const Real v[5] = { Js[d], onGrains[reached[x]][d], J.solid[d], J.water[d], aj[d] };
-					const Real z[5] = { ss[I][d] * v[0] + v[1], v[0], ss[I][d] * v[2] + cross[d] * v[3], cross[d] * v[2] + ww[I][d] * v[3],
-					                    -perVolume * system.mobility[I][d] * v[4] };
-					for (int e = 0; e < 5; ++e) u[x][5 * d + e] = v[e], zu[x][5 * d + e] = z[e];
-				}
-			}
-			for (int x = 0; x < m; ++x) {
-				const int j = reached[x];
-				for (int y = x; y < m; ++y) {
-					const int k     = reached[y];
-					Real      value = 0;
-					for (int e = 0; e < 15; ++e) value += u[y][e] * zu[x][e];
-					if (value == 0) continue;
-					// the row with the smaller index holds the pair, at the partner's offset from it
-					int a = rowOf[j], from = j, to = k;
-					if (rowOf[k] < a) a = rowOf[k], from = k, to = j;
-					if (blockOf[a] < 0) blockOf[a] = static_cast<int>(blocks.size() / blockSlots), blocks.resize(blocks.size() + blockSlots, 0);
-					const int slot = (to / 25 - from / 25 + 4) * 81 + ((to / 5) % 5 - (from / 5) % 5 + 4) * 9 + (to % 5 - from % 5 + 4);
-					blocks[static_cast<std::size_t>(blockOf[a]) * blockSlots + slot] += value;
+		for (int t = 1; t < pointThreads; ++t) {
+			const auto& more  = system.surfaceCouplingBuffers[static_cast<std::size_t>(t - 1)];
+			const auto& share = system.sampledSupportBuffers[static_cast<std::size_t>(t - 1)];
+			for (std::size_t c = 0; c < candidates.size(); ++c) {
+				sampled[c] += share[c];
+				for (int o = 0; o < 125; ++o) {
+					coupling[c][o].surface += more[c][o].surface;
+					coupling[c][o].solid += more[c][o].solid;
+					coupling[c][o].water += more[c][o].water;
 				}
 			}
 		}
-		for (std::size_t a = 0; a < system.node.size(); ++a) {
-			if (blockOf[a] < 0) continue;
-			const Real*              block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots;
-			const std::array<int, 3> ia    = grid.indices(system.node[a]);
-			for (int slot = 0; slot < blockSlots; ++slot) {
-				if (block[slot] == 0) continue;
-				const int b = system.row[grid.index(ia[0] + slot % 9 - 4, ia[1] + (slot / 9) % 9 - 4, ia[2] + slot / 81 - 4)];
-				pairs.push_back(PressureSystem::NodePair { a, static_cast<std::size_t>(b), block[slot] });
+		// eq. 8.5f per candidate I: node I's share of K becomes L_I − Δt λ_I a aᵀ/V^w_I + F_Iᵀ R_I F_I (a
+		// covariance and a Gram matrix: K positive definite by construction), i.e. L plus, per pair (J, K),
+		// value = Σ_d u_K,dᵀ Z_d u_J,d with u_J,d = (Σ_IJ where it counts, g^s_IJ, g^w_IJ) along axis d and
+		// Z_d the 3×3 form below (R g and a = g^s + g^w are combinations of g^s and g^w)
+		auto addCandidate = [&](std::size_t c, std::vector<Real>& blocks, std::vector<int>& blockOf) {
+			const std::size_t        r   = candidates[c];
+			const std::size_t        I   = system.node[r];
+			const std::array<int, 3> idx = grid.indices(I);
+			// the surface term of a node J whose product support with I lies inside the soil is round-off
+			// (Σ_IJ → 0); the pairs of such nodes keep the gradient form's part
+			Real largest = 0;
+			for (int o = 0; o < 125; ++o) largest = std::max(largest, coupling[c][o].surface.norm());
+			if (!(largest > 0)) return;
+			const Real negligible = surfaceShareTolerance * largest;
+			// the reached rows in offset order, which is the rows' order (rows are numbered in grid-node
+			// order and the box around I does not wrap), so a pair's first node always has the smaller row
+			int rowOf[125], code[125], m = 0;
+			alignas(64) Real u[9][125];
+			for (int o = 0; o < 125; ++o) {
+				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, cc = o / 25 - 2;
+				const int x = idx[0] + a, y = idx[1] + b, z = idx[2] + cc;
+				if (x < 0 || y < 0 || z < 0 || x >= grid.nodes[0] || y >= grid.nodes[1] || z >= grid.nodes[2]) continue;
+				const int row = system.row[grid.index(x, y, z)];
+				if (row < 0) continue;
+				const Coupling& J       = coupling[c][o];
+				const bool      counts  = J.surface.norm() > negligible;
+				rowOf[m]                = row;
+				code[m]                 = (o / 25) * 81 + ((o / 5) % 5) * 9 + o % 5; // the offset in base 9
+				for (int d = 0; d < 3; ++d) u[3 * d][m] = counts ? J.surface[d] : 0, u[3 * d + 1][m] = J.solid[d], u[3 * d + 2][m] = J.water[d];
+				++m;
 			}
+			const Vec3 cross     = 0.5 * (sw[I] + ws[I]); // R's off-diagonal: the same both ways up to round-off
+			const Real perVolume = sampled[c] > 0 ? dt / sampled[c] : 0;
+			// Z_d over (Σ, g^s, g^w): Σᵀ R_ss Σ + Σᵀ R g + (R g)ᵀ Σ (the surface terms), g_Jᵀ R_I g_K (the gradient form's
+			// true lumped share), − Δt λ_I a_J a_K / V^w_I (the share L's mobility implies)
+			Real Z[3][3][3];
+			for (int d = 0; d < 3; ++d) {
+				const Real q = perVolume * system.mobility[I][d];
+				const Real zd[3][3] = { { ss[I][d], ss[I][d], sw[I][d] }, { ss[I][d], ss[I][d] - q, cross[d] - q }, { sw[I][d], cross[d] - q, ww[I][d] - q } };
+				for (int e = 0; e < 3; ++e)
+					for (int f = 0; f < 3; ++f) Z[d][e][f] = zd[e][f];
+			}
+			constexpr int centre = 4 * 81 + 4 * 9 + 4; // offset (0, 0, 0) in a block
+			alignas(64) Real value[125];
+			for (int x = 0; x < m; ++x) {
+				Real zu[9];
+				for (int d = 0; d < 3; ++d)
+					for (int e = 0; e < 3; ++e) zu[3 * d + e] = Z[d][e][0] * u[3 * d][x] + Z[d][e][1] * u[3 * d + 1][x] + Z[d][e][2] * u[3 * d + 2][x];
+				for (int y = x; y < m; ++y) value[y] = 0;
+				for (int e = 0; e < 9; ++e) {
+					const Real  z   = zu[e];
+					const Real* col = u[e];
+					for (int y = x; y < m; ++y) value[y] += col[y] * z;
+				}
+				const int a = rowOf[x];
+				if (blockOf[a] < 0) blockOf[a] = static_cast<int>(blocks.size() / blockSlots), blocks.resize(blocks.size() + blockSlots, 0);
+				Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots + centre - code[x];
+				for (int y = x; y < m; ++y) block[code[y]] += value[y];
+			}
+		};
+		// the candidates split among the threads, each summing into its own blocks; then summed in thread order
+		const int threads = candidates.size() < parallelSurfaceNodes ? 1 : std::min<int>(omp_get_max_threads(), static_cast<int>(candidates.size()));
+		system.pairBlocks.resize(static_cast<std::size_t>(threads));
+		system.pairBlockOf.resize(static_cast<std::size_t>(threads));
+#pragma omp parallel num_threads(threads)
+		{
+			const std::size_t  t       = static_cast<std::size_t>(omp_get_thread_num());
+			std::vector<Real>& blocks  = system.pairBlocks[t];
+			std::vector<int>&  blockOf = system.pairBlockOf[t];
+			blocks.clear();
+			blockOf.assign(active, -1);
+#pragma omp for schedule(static)
+			for (std::size_t c = 0; c < candidates.size(); ++c) addCandidate(c, blocks, blockOf);
+		}
+		// the other threads' blocks added into thread 0's, row by row in thread order; then each row's pairs
+		std::vector<Real>& blocks  = system.pairBlocks[0];
+		std::vector<int>&  blockOf = system.pairBlockOf[0];
+		for (int t = 1; t < threads; ++t)
+			for (std::size_t a = 0; a < active; ++a) {
+				const int b = system.pairBlockOf[static_cast<std::size_t>(t)][a];
+				if (b < 0) continue;
+				const Real* more = system.pairBlocks[static_cast<std::size_t>(t)].data() + static_cast<std::size_t>(b) * blockSlots;
+				if (blockOf[a] < 0) {
+					blockOf[a] = static_cast<int>(blocks.size() / blockSlots);
+					blocks.insert(blocks.end(), more, more + blockSlots);
+				} else {
+					Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots;
+					for (int slot = 0; slot < blockSlots; ++slot) block[slot] += more[slot];
+				}
+			}
+		std::array<long, blockSlots> step; // a slot's offset as a step in grid-node index
+		for (int slot = 0; slot < blockSlots; ++slot)
+			step[slot] = (slot % 9 - 4) + static_cast<long>(grid.nodes[0]) * ((slot / 9) % 9 - 4 + static_cast<long>(grid.nodes[1]) * (slot / 81 - 4));
+		for (std::size_t a = 0; a < active; ++a) {
+			if (blockOf[a] < 0) continue;
+			const Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots;
+			const long  I     = static_cast<long>(system.node[a]);
+			for (int slot = 0; slot < blockSlots; ++slot)
+				if (block[slot] != 0) pairs.push_back(PressureSystem::NodePair { a, static_cast<std::size_t>(system.row[static_cast<std::size_t>(I + step[slot])]), block[slot] });
 		}
 	}
 

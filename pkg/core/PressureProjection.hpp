@@ -105,8 +105,10 @@ struct PressureSystem {
 	std::vector<Vec3>                             grainResponse[2]; // (same): Δt M⁻¹ on the grains for a unit force on the grains, on the water
 	std::vector<Vec3>                             waterResponse[2]; // (same): on the water
 	std::vector<Real>                             sampledSupport;   // (same): V^w_I = Σ_wp V S_I per node with surface terms [m³]
-	std::vector<Real>                             pairBlocks;       // (same): per row they reach, its pairs by offset (9³ slots)
-	std::vector<int>                              pairBlockOf;      // (same): per row, its block in pairBlocks, −1: none
+	std::vector<std::vector<std::array<SurfaceCoupling, 125>>> surfaceCouplingBuffers; // (same), per extra thread
+	std::vector<std::vector<Real>>                sampledSupportBuffers;                // (same), per extra thread
+	std::vector<std::vector<Real>>                pairBlocks;       // (same), per thread: per row they reach, its pairs by offset (9³ slots)
+	std::vector<std::vector<int>>                 pairBlockOf;      // (same), per thread: per row, its block in pairBlocks, −1: none
 	std::vector<FreePair> pairScratch;                              // buildPressureMatrix's scratch, kept from step to step
 	std::vector<int>      rowCount, cursorScratch, columnScratch; // (same)
 	std::vector<Real>     valueScratch;                           // (same)
