@@ -14,10 +14,10 @@ public:                                                                         
 	boost::python::dict pyDict() const override { return yade_mpm::dictFromTable<Cls, yade::Base>(*this); }        \
 	static const yade_mpm::AttrTable<Cls>& attributes();                                                            \
 	/* saved scenes: the base, then every attribute the table marks as saved, in table order */                    \
-	template <class Archive> void serialize(Archive& ar, unsigned int)                                              \
+	template <class Archive> void serialize(Archive& ar, unsigned int version)                                      \
 	{                                                                                                               \
 		ar& boost::serialization::make_nvp(#Base, boost::serialization::base_object<yade::Base>(*this));          \
-		yade_mpm::serializeAttributes(ar, *this);                                                               \
+		yade_mpm::serializeAttributes(ar, *this, version, #Cls);                                                \
 	}
 
 // A class-unique index among its kin (YADE dispatchers look functors up by it).
@@ -36,3 +36,6 @@ public:                                                                         
 	{                                                                                                               \
 		return depth <= 1 ? yade::Base::getClassIndex() : yade::Base::getBaseClassIndex(depth - 1);               \
 	}
+
+// The class version saves carry (savedLayoutVersion); at namespace scope, after the class.
+#define MPM_SAVED_LAYOUT_VERSION(Cls) BOOST_CLASS_VERSION(yade_mpm::Cls, yade_mpm::savedLayoutVersion)

@@ -39,3 +39,5 @@ private:
 };
 
 } // namespace yade_mpm
+
+MPM_SAVED_LAYOUT_VERSION(MpmHdf5Recorder)

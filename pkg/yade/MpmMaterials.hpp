@@ -57,3 +57,6 @@ private:
 };
 
 } // namespace yade_mpm
+
+MPM_SAVED_LAYOUT_VERSION(MpmSoilMat)
+MPM_SAVED_LAYOUT_VERSION(MpmWaterMat)

@@ -38,3 +38,6 @@ public:
 };
 
 } // namespace yade_mpm
+
+MPM_SAVED_LAYOUT_VERSION(MpmSolidPoints)
+MPM_SAVED_LAYOUT_VERSION(MpmWaterPoints)

@@ -67,3 +67,5 @@ private:
 };
 
 } // namespace yade_mpm
+
+MPM_SAVED_LAYOUT_VERSION(MpmTwoPhaseEngine)

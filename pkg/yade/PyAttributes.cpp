@@ -1,5 +1,6 @@
 #include "PyAttributes.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <sstream>
 
@@ -67,6 +68,30 @@ std::size_t doublesFromNumpy(const std::string& name, const py::object& value, c
 	BufferView buffer(array.ptr(), PyBUF_C_CONTIGUOUS);
 	if (!out.empty()) std::memcpy(out.data(), buffer.view.buf, out.size() * sizeof(double));
 	return shape[0];
+}
+
+} // namespace yade_mpm
+
+namespace yade_mpm {
+
+std::string layoutMismatch(const std::string& className, const std::string& saved, const std::string& current)
+{
+	auto words = [](const std::string& text) {
+		std::vector<std::string> out;
+		std::istringstream       in(text);
+		for (std::string w; in >> w;) out.push_back(w);
+		return out;
+	};
+	const std::vector<std::string> was = words(saved), is = words(current);
+	auto missingFrom = [](const std::vector<std::string>& from, const std::vector<std::string>& in) {
+		std::string list;
+		for (const std::string& w : from)
+			if (std::find(in.begin(), in.end(), w) == in.end()) list += (list.empty() ? "" : ", ") + w;
+		return list.empty() ? std::string("none") : list;
+	};
+	return className + " was saved by another yade-mpm: its saved attributes differ from this build's (only in the save: " + missingFrom(was, is) +
+	       "; only in this build: " + missingFrom(is, was) + (missingFrom(was, is) == "none" && missingFrom(is, was) == "none" ? "; same names in another order" : "") +
+	       "): they cannot be matched; rebuild the scene with this version's script";
 }
 
 } // namespace yade_mpm

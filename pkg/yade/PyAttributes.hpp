@@ -59,9 +59,36 @@ template <class T> struct AttrSpec {
 
 template <class T> using AttrTable = std::vector<AttrSpec<T>>;
 
-// The table drives serialization: every saved attribute, in table order.
-template <class Archive, class T> void serializeAttributes(Archive& ar, T& self)
+// The saved attributes' names in table order, space-separated: a save's layout.
+template <class T> std::string savedLayout()
 {
+	std::string layout;
+	for (const auto& spec : T::attributes())
+		if (spec.archive) layout += (layout.empty() ? "" : " ") + spec.name;
+	return layout;
+}
+
+// Why a save written with another attribute layout cannot be read: the names one has and the other lacks.
+std::string layoutMismatch(const std::string& className, const std::string& saved, const std::string& current);
+
+// The table drives serialization: the layout (savedLayout), then every saved attribute in table order.
+// A save whose class version is older than savedLayoutVersion (written before saves carried their
+// layout) or whose layout differs from this build's is refused with a message naming the class and
+// the attributes, before any attribute is read: its fields would be read into the wrong attributes.
+template <class Archive, class T> void serializeAttributes(Archive& ar, T& self, unsigned int version, const char* className)
+{
+	std::string layout = savedLayout<T>();
+	if constexpr (Archive::is_loading::value) {
+		if (version < savedLayoutVersion)
+			throw std::runtime_error(std::string(className) + " was saved by an older yade-mpm (class version " + std::to_string(version) +
+			                         ", before saves carried their attribute layout; this build reads version " + std::to_string(savedLayoutVersion) +
+			                         "): its attributes cannot be matched; rebuild the scene with this version's script");
+		std::string saved;
+		ar& boost::serialization::make_nvp("savedAttributes", saved);
+		if (saved != layout) throw std::runtime_error(layoutMismatch(className, saved, layout));
+	} else {
+		ar& boost::serialization::make_nvp("savedAttributes", layout);
+	}
 	for (const auto& spec : T::attributes())
 		if (spec.archive) spec.archive(ar, self);
 }

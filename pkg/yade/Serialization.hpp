@@ -12,6 +12,7 @@
 #include <boost/serialization/export.hpp>
 #include <boost/serialization/nvp.hpp>
 #include <boost/serialization/string.hpp>
+#include <boost/serialization/version.hpp>
 
 #include "YadeAbi.hpp"
 
@@ -23,6 +24,10 @@ MPM_YADE_EXTERN_SERIALIZERS(Shape)
 MPM_YADE_EXTERN_SERIALIZERS(Material)
 
 namespace yade_mpm {
+
+// The class version every plugin class is saved with (BOOST_CLASS_VERSION, MPM_SAVED_LAYOUT_VERSION):
+// 1 since saves carry their attribute layout (serializeAttributes); saves of version 0 did not.
+constexpr unsigned int savedLayoutVersion = 1;
 
 // Serialize a vector of fixed-size Eigen objects (or doubles) as its length and a flat block of
 // doubles: compact in binary archives, exact (17 significant digits) in xml.

@@ -5,12 +5,15 @@ load, naming the file, not later as an instability of the first step.
 YADE's own messages ("input stream error", "gzip error: iostream error") name neither the file nor
 the cause; the wrappers add both and keep YADE's exception type.
 """
+import re
+
 import numpy as np
 
 import yade.wrapper
 
 _POINT_SHAPES = ("MpmSolidPoints", "MpmWaterPoints")
 _WRAPPED = "_yade_mpm_wrapped"
+_OTHER_VERSION = re.compile(r"was saved by (an older|another) yade-mpm")  # the plugin's layout check (PyAttributes.hpp)
 
 
 def check_point_sets(omega, source):
@@ -38,6 +41,8 @@ def _wrap(method, describe):
         try:
             method(self, *args, **kwargs)
         except RuntimeError as error:
+            if _OTHER_VERSION.search(str(error)):  # the plugin's own layout check: its message says it all
+                raise RuntimeError("%s: %s" % (source, error)) from error
             raise RuntimeError("%s: the saved scene cannot be read (%s): the file is missing, truncated or corrupt, or was not saved by "
                                "this YADE" % (source, error)) from error
         check_point_sets(self, source)

@@ -2,6 +2,7 @@
 also in a fresh process; without the plugin, loading fails cleanly and the process lives on."""
 import json
 import os
+import re
 
 import numpy as np
 import pytest
@@ -137,6 +138,33 @@ def test_a_truncated_or_corrupt_saved_scene_is_reported_at_the_load_naming_the_f
     spoilt.write_text(text[:item] + "<item>nan</item>" + text[text.index("</item>", item) + len("</item>"):])
     with pytest.raises(ValueError, match=r"O.load\('.*spoilt.xml'\): O.bodies\[1\].shape.porePressure\[0\] = nan is not finite: the saved scene is corrupt"):
         O.load(str(spoilt))
+    O.load(str(saved))  # the intact file still loads and runs
+    O.step()
+    assert O.engines[0].stepsDone == 3
+
+
+def test_a_save_of_another_attribute_layout_is_refused_naming_the_class_and_the_attributes(tmp_path):
+    """A save carries each plugin class's saved attribute names (and class version 1): read into a
+    build whose attributes differ, its fields would land in the wrong attributes (a length read
+    from a double gave a bare MemoryError before). The load now refuses it before reading any
+    attribute, naming the file, the class and what differs; a save from before this check (class
+    version 0) is refused as older."""
+    small_scene()
+    saved = tmp_path / "scene.xml"
+    O.save(str(saved))
+    text = saved.read_text()
+    assert "<savedAttributes>gravity timeStepFactor " in text
+    other = tmp_path / "other.xml"
+    other.write_text(text.replace("<savedAttributes>gravity timeStepFactor ", "<savedAttributes>timeStepFactor wetness ", 1))
+    with pytest.raises(RuntimeError, match=r"O.load\('.*other.xml'\): MpmTwoPhaseEngine was saved by another yade-mpm: its saved attributes differ "
+                                           r"from this build's \(only in the save: wetness; only in this build: gravity\)"):
+        O.load(str(other))
+    engine_class = re.search(r'class_name="MpmTwoPhaseEngine" tracking_level="1" version="(\d+)"', text)
+    assert engine_class and engine_class.group(1) == "1"
+    older = tmp_path / "older.xml"
+    older.write_text(text[:engine_class.start(1)] + "0" + text[engine_class.end(1):])
+    with pytest.raises(RuntimeError, match=r"O.load\('.*older.xml'\): MpmTwoPhaseEngine was saved by an older yade-mpm \(class version 0, "):
+        O.load(str(older))
     O.load(str(saved))  # the intact file still loads and runs
     O.step()
     assert O.engines[0].stepsDone == 3
