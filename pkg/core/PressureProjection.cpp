@@ -539,37 +539,38 @@ namespace stages {
 			++count[row + 1];
 			if (column != row) ++count[column + 1];
 		};
+		// the pair (r, J) of K with its value (stored row or extra pair): into the free rows, or onto the
+		// right-hand side where one end is prescribed
+		auto addPair = [&](std::size_t r, std::size_t J, Real value) {
+			const int ur = unknownOf[r], uJ = unknownOf[J];
+			if (r == J) {
+				if (ur >= 0) add(ur, ur, weightOf[r] * weightOf[r] * value);
+			} else if (ur >= 0 && uJ >= 0) {
+				const Real tied = weightOf[r] * weightOf[J] * value;
+				if (ur == uJ) add(ur, ur, 2 * tied); // a tied node and its master: K_rJ and K_Jr both land on the diagonal
+				else add(ur, uJ, tied);
+			} else if (ur >= 0) system.rhs[ur] -= weightOf[r] * value * system.fixedValue[J];
+			else if (uJ >= 0) system.rhs[uJ] -= weightOf[J] * value * system.fixedValue[r];
+		};
+		// the extra pairs by (row, column), as meniscusPairs emits them: row r's join its stored ones in
+		// column order, a column both hold as one entry, so that the rows stay in order without a sort
+		std::vector<PressureSystem::NodePair>& extra = system.extraPairs;
+		auto byRowThenColumn = [](const PressureSystem::NodePair& x, const PressureSystem::NodePair& y) { return x.row < y.row || (x.row == y.row && x.column < y.column); };
+		if (!std::is_sorted(extra.begin(), extra.end(), byRowThenColumn)) std::sort(extra.begin(), extra.end(), byRowThenColumn);
+		std::size_t next = 0;
 		for (std::size_t r = 0; r < active; ++r) {
 			const Real*              k   = system.rows.data() + r * PressureSystem::rowStride;
 			const std::array<int, 3> idx = grid.indices(system.node[r]);
-			const int                ur  = unknownOf[r];
 			for (int o = centreSlot; o < PressureSystem::offsets; ++o) {
-				const Real value = k[o - centreSlot];
+				Real value = k[o - centreSlot];
 				if (value == 0) continue; // a non-zero coefficient joins two nodes of one stencil: both on the grid
-				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, c = o / 25 - 2;
-				const int J  = system.row[grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c))];
-				const int uJ = unknownOf[J];
-				if (o == centreSlot) {
-					if (ur >= 0) add(ur, ur, weightOf[r] * weightOf[r] * value);
-				} else if (ur >= 0 && uJ >= 0) {
-					const Real tied = weightOf[r] * weightOf[J] * value;
-					if (ur == uJ) add(ur, ur, 2 * tied); // a tied node and its master: K_rJ and K_Jr both land on the diagonal
-					else add(ur, uJ, tied);
-				} else if (ur >= 0) system.rhs[ur] -= weightOf[r] * value * system.fixedValue[J];
-				else if (uJ >= 0) system.rhs[uJ] -= weightOf[J] * value * system.fixedValue[r];
+				const int         a = o % 5 - 2, b = (o / 5) % 5 - 2, c = o / 25 - 2;
+				const std::size_t J = static_cast<std::size_t>(system.row[grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c))]);
+				for (; next < extra.size() && extra[next].row == r && extra[next].column < J; ++next) addPair(r, extra[next].column, extra[next].value);
+				if (next < extra.size() && extra[next].row == r && extra[next].column == J) value += extra[next++].value;
+				addPair(r, J, value);
 			}
-		}
-		for (const PressureSystem::NodePair& e : system.extraPairs) {
-			const std::size_t r = e.row, J = e.column;
-			const int         ur = unknownOf[r], uJ = unknownOf[J];
-			if (r == J) {
-				if (ur >= 0) add(ur, ur, weightOf[r] * weightOf[r] * e.value);
-			} else if (ur >= 0 && uJ >= 0) {
-				const Real tied = weightOf[r] * weightOf[J] * e.value;
-				if (ur == uJ) add(ur, ur, 2 * tied);
-				else add(ur, uJ, tied);
-			} else if (ur >= 0) system.rhs[ur] -= weightOf[r] * e.value * system.fixedValue[J];
-			else if (uJ >= 0) system.rhs[uJ] -= weightOf[J] * e.value * system.fixedValue[r];
+			for (; next < extra.size() && extra[next].row == r; ++next) addPair(r, extra[next].column, extra[next].value);
 		}
 		for (int i = 0; i < n; ++i) count[i + 1] += count[i];
 		std::vector<int>&  column = system.columnScratch;
@@ -584,7 +585,10 @@ namespace stages {
 		}
 		// sort and merge in place the rows out of order (a tied node's, a wrapped periodic axis's); `merged` keeps the new lengths
 		std::vector<int>& merged = system.cursorScratch;
-#pragma omp parallel for schedule(static) if(n > static_cast<int>(parallelThreshold))
+#pragma omp parallel if(n > static_cast<int>(parallelThreshold))
+		{
+		std::vector<std::pair<int, Real>> row;
+#pragma omp for schedule(static)
 		for (int u = 0; u < n; ++u) {
 			const int first = count[u], last = count[u + 1];
 			bool      sorted = true;
@@ -593,7 +597,7 @@ namespace stages {
 				merged[u] = last - first;
 				continue;
 			}
-			std::vector<std::pair<int, Real>> row;
+			row.clear();
 			for (int e = first; e < last; ++e) row.emplace_back(column[e], value[e]);
 			std::sort(row.begin(), row.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
 			int m = 0;
@@ -602,6 +606,7 @@ namespace stages {
 				else column[first + m] = col, value[first + m] = v, ++m;
 			}
 			merged[u] = m;
+		}
 		}
 		Eigen::SparseMatrix<Real, Eigen::RowMajor>& A = system.matrix;
 		A.resize(n, n);
@@ -890,7 +895,9 @@ namespace stages {
 	                   const std::vector<char>& candidate, PressureSystem& system, std::vector<PressureSystem::NodePair>& pairs)
 	{
 		pairs.clear();
-		constexpr int blockSlots = 9 * 9 * 9; // the offsets (−4…4)³ from a row's node to its partner's
+		// a row's partners lie at offsets (−4…4)³ from it and after it in (z, y, x) order (a pair is
+		// stored on its first row): in base 9 with digits −4…4, the offsets 0…364
+		constexpr int blockSlots = (9 * 9 * 9 + 1) / 2;
 		const std::size_t nodes = grid.nodeCount(), active = system.node.size();
 		// the nodal response Δt M⁻¹ per axis (with the walls' holds) to a unit force on the grains and on the water
 		std::vector<Vec3>& ss = system.grainResponse[0];
@@ -995,7 +1002,7 @@ namespace stages {
 		// covariance and a Gram matrix: K positive definite by construction), i.e. L plus, per pair (J, K),
 		// value = Σ_d u_K,dᵀ Z_d u_J,d with u_J,d = (Σ_IJ where it counts, g^s_IJ, g^w_IJ) along axis d and
 		// Z_d the 3×3 form below (R g and a = g^s + g^w are combinations of g^s and g^w)
-		auto addCandidate = [&](std::size_t c, std::vector<Real>& blocks, std::vector<int>& blockOf) {
+		auto addCandidate = [&](std::size_t c, std::vector<Real>& blocks, std::vector<int>& blockOf, std::size_t& used) {
 			const std::size_t        r   = candidates[c];
 			const std::size_t        I   = system.node[r];
 			const std::array<int, 3> idx = grid.indices(I);
@@ -1033,7 +1040,6 @@ namespace stages {
 				for (int e = 0; e < 3; ++e)
 					for (int f = 0; f < 3; ++f) Z[d][e][f] = zd[e][f];
 			}
-			constexpr int centre = 4 * 81 + 4 * 9 + 4; // offset (0, 0, 0) in a block
 			alignas(64) Real value[125];
 			for (int x = 0; x < m; ++x) {
 				Real zu[9];
@@ -1046,9 +1052,12 @@ namespace stages {
 					for (int y = x; y < m; ++y) value[y] += col[y] * z;
 				}
 				const int a = rowOf[x];
-				if (blockOf[a] < 0) blockOf[a] = static_cast<int>(blocks.size() / blockSlots), blocks.resize(blocks.size() + blockSlots, 0);
-				Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots + centre - code[x];
-				for (int y = x; y < m; ++y) block[code[y]] += value[y];
+				if (blockOf[a] < 0) {
+					blockOf[a] = static_cast<int>(used++);
+					if (blocks.size() < used * blockSlots) blocks.resize(used * blockSlots, 0); // kept zero between steps: grown only
+				}
+				Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots - code[x];
+				for (int y = x; y < m; ++y) block[code[y]] += value[y]; // code[y] ≥ code[x]: offset order
 			}
 		};
 		// the candidates split among the threads, each summing into its own blocks; then summed in thread order
@@ -1060,36 +1069,32 @@ namespace stages {
 			const std::size_t  t       = static_cast<std::size_t>(omp_get_thread_num());
 			std::vector<Real>& blocks  = system.pairBlocks[t];
 			std::vector<int>&  blockOf = system.pairBlockOf[t];
-			blocks.clear();
+			std::size_t        used    = 0;
 			blockOf.assign(active, -1);
 #pragma omp for schedule(static)
-			for (std::size_t c = 0; c < candidates.size(); ++c) addCandidate(c, blocks, blockOf);
+			for (std::size_t c = 0; c < candidates.size(); ++c) addCandidate(c, blocks, blockOf, used);
 		}
-		// the other threads' blocks added into thread 0's, row by row in thread order; then each row's pairs
-		std::vector<Real>& blocks  = system.pairBlocks[0];
-		std::vector<int>&  blockOf = system.pairBlockOf[0];
-		for (int t = 1; t < threads; ++t)
-			for (std::size_t a = 0; a < active; ++a) {
-				const int b = system.pairBlockOf[static_cast<std::size_t>(t)][a];
-				if (b < 0) continue;
-				const Real* more = system.pairBlocks[static_cast<std::size_t>(t)].data() + static_cast<std::size_t>(b) * blockSlots;
-				if (blockOf[a] < 0) {
-					blockOf[a] = static_cast<int>(blocks.size() / blockSlots);
-					blocks.insert(blocks.end(), more, more + blockSlots);
-				} else {
-					Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots;
-					for (int slot = 0; slot < blockSlots; ++slot) block[slot] += more[slot];
-				}
-			}
+		// each row's pairs: its blocks summed in thread order (the sums do not depend on which threads
+		// reached the row: 0 + x = x), each slot zeroed as it is read so the blocks start the next step zero
 		std::array<long, blockSlots> step; // a slot's offset as a step in grid-node index
-		for (int slot = 0; slot < blockSlots; ++slot)
-			step[slot] = (slot % 9 - 4) + static_cast<long>(grid.nodes[0]) * ((slot / 9) % 9 - 4 + static_cast<long>(grid.nodes[1]) * (slot / 81 - 4));
+		for (int slot = 0; slot < blockSlots; ++slot) {
+			const int o = slot + blockSlots - 1; // the offset + (4, 4, 4) in base 9, digits 0…8
+			step[slot]  = (o % 9 - 4) + static_cast<long>(grid.nodes[0]) * ((o / 9) % 9 - 4 + static_cast<long>(grid.nodes[1]) * (o / 81 - 4));
+		}
+		std::vector<Real*> reached(static_cast<std::size_t>(threads));
 		for (std::size_t a = 0; a < active; ++a) {
-			if (blockOf[a] < 0) continue;
-			const Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots;
-			const long  I     = static_cast<long>(system.node[a]);
-			for (int slot = 0; slot < blockSlots; ++slot)
-				if (block[slot] != 0) pairs.push_back(PressureSystem::NodePair { a, static_cast<std::size_t>(system.row[static_cast<std::size_t>(I + step[slot])]), block[slot] });
+			int count = 0;
+			for (int t = 0; t < threads; ++t) {
+				const int b = system.pairBlockOf[static_cast<std::size_t>(t)][a];
+				if (b >= 0) reached[static_cast<std::size_t>(count++)] = system.pairBlocks[static_cast<std::size_t>(t)].data() + static_cast<std::size_t>(b) * blockSlots;
+			}
+			if (count == 0) continue;
+			const long I = static_cast<long>(system.node[a]);
+			for (int slot = 0; slot < blockSlots; ++slot) {
+				Real value = 0;
+				for (int k = 0; k < count; ++k) value += reached[static_cast<std::size_t>(k)][slot], reached[static_cast<std::size_t>(k)][slot] = 0;
+				if (value != 0) pairs.push_back(PressureSystem::NodePair { a, static_cast<std::size_t>(system.row[static_cast<std::size_t>(I + step[slot])]), value });
+			}
 		}
 	}
 

@@ -107,7 +107,7 @@ struct PressureSystem {
 	std::vector<Real>                             sampledSupport;   // (same): V^w_I = Σ_wp V S_I per node with surface terms [m³]
 	std::vector<std::vector<std::array<SurfaceCoupling, 125>>> surfaceCouplingBuffers; // (same), per extra thread
 	std::vector<std::vector<Real>>                sampledSupportBuffers;                // (same), per extra thread
-	std::vector<std::vector<Real>>                pairBlocks;       // (same), per thread: per row they reach, its pairs by offset (9³ slots)
+	std::vector<std::vector<Real>>                pairBlocks;       // (same), per thread: per row they reach, its pairs by offset (365 slots: (−4…4)³ after the row's node); zero between steps
 	std::vector<std::vector<int>>                 pairBlockOf;      // (same), per thread: per row, its block in pairBlocks, −1: none
 	std::vector<FreePair> pairScratch;                              // buildPressureMatrix's scratch, kept from step to step
 	std::vector<int>      rowCount, cursorScratch, columnScratch; // (same)
