@@ -888,6 +888,8 @@ namespace stages {
 	constexpr Real surfaceShareTolerance = 1e-9;
 	// meniscusPairs shares its surface nodes among the threads from this many on (one costs ≈ 40 µs)
 	constexpr std::size_t parallelSurfaceNodes = 8;
+	// and the water points next to them from this many on (one costs ≈ 1 µs)
+	constexpr std::size_t parallelSurfacePoints = 64;
 
 	template <class Kernel>
 	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, std::vector<WaterPointSet*>& sets, const ConstrainedNodes& constrained,
@@ -930,10 +932,23 @@ namespace stages {
 		std::vector<Real>& sampled = system.sampledSupport; // V^w_I = Σ_wp V S_I, per candidate
 		sampled.assign(candidates.size(), 0);
 		constexpr int S = Kernel::stencil;
+		// the water points whose stencil reaches a surface node, in set and point order: the pass below
+		// shares them, not all points, evenly among the threads (they gather where the surface is)
+		std::vector<std::pair<const WaterPointSet*, std::size_t>> touching;
+		for (const WaterPointSet* set : sets) {
+			const WaterPointSet& P = *set;
+			std::vector<char>    reaches(P.size(), 0);
+#pragma omp parallel for schedule(static) if(P.size() > parallelThreshold)
+			for (std::size_t p = 0; p < P.size(); ++p) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P, p, w);
+				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real, const Vec3&) { reaches[p] = reaches[p] || slotOf[J] >= 0; });
+			}
+			for (std::size_t p = 0; p < P.size(); ++p)
+				if (reaches[p]) touching.emplace_back(set, p);
+		}
 		// thread 0 sums into `coupling` and `sampled`, the others into their own copies, added after in thread order
-		std::size_t waterPoints = 0;
-		for (const WaterPointSet* set : sets) waterPoints += set->size();
-		const int pointThreads = waterPoints <= parallelThreshold ? 1 : omp_get_max_threads();
+		const int pointThreads = touching.size() <= parallelSurfacePoints ? 1 : omp_get_max_threads();
 		system.surfaceCouplingBuffers.resize(static_cast<std::size_t>(pointThreads - 1));
 		system.sampledSupportBuffers.resize(static_cast<std::size_t>(pointThreads - 1));
 #pragma omp parallel num_threads(pointThreads)
@@ -946,24 +961,21 @@ namespace stages {
 				for (auto& c : mine) c.fill(Coupling {});
 				myShare.assign(candidates.size(), 0);
 			}
-			for (const WaterPointSet* set : sets) {
-				const WaterPointSet& P = *set;
 #pragma omp for schedule(static)
-				for (std::size_t p = 0; p < P.size(); ++p) {
+				for (std::size_t k = 0; k < touching.size(); ++k) {
+					const WaterPointSet& P = *touching[k].first;
+					const std::size_t    p = touching[k].second;
 					Weights1D w[3];
 					weightsAt<Kernel>(grid, P, p, w);
 					std::size_t I[S * S * S];
 					Real        N[S * S * S];
 					Vec3        dN[S * S * S];
 					int         m       = 0;
-					bool        touches = false;
 					Real        n       = 0;
 					forEachNode<Kernel>(grid, w, [&](std::size_t J, Real NJ, const Vec3& dNJ) {
 						I[m] = J, N[m] = NJ, dN[m] = dNJ, ++m;
 						n += NJ * fields.porosity[J];
-						touches = touches || slotOf[J] >= 0;
 					});
-					if (!touches) continue;
 					n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 					const Real V = P.volume[p];
 					std::array<int, 3> at[S * S * S];
@@ -984,7 +996,6 @@ namespace stages {
 						}
 					}
 				}
-			}
 		}
 		for (int t = 1; t < pointThreads; ++t) {
 			const auto& more  = system.surfaceCouplingBuffers[static_cast<std::size_t>(t - 1)];
@@ -1081,21 +1092,39 @@ namespace stages {
 			const int o = slot + blockSlots - 1; // the offset + (4, 4, 4) in base 9, digits 0…8
 			step[slot]  = (o % 9 - 4) + static_cast<long>(grid.nodes[0]) * ((o / 9) % 9 - 4 + static_cast<long>(grid.nodes[1]) * (o / 81 - 4));
 		}
-		std::vector<Real*> reached(static_cast<std::size_t>(threads));
-		for (std::size_t a = 0; a < active; ++a) {
-			int count = 0;
-			for (int t = 0; t < threads; ++t) {
-				const int b = system.pairBlockOf[static_cast<std::size_t>(t)][a];
-				if (b >= 0) reached[static_cast<std::size_t>(count++)] = system.pairBlocks[static_cast<std::size_t>(t)].data() + static_cast<std::size_t>(b) * blockSlots;
-			}
-			if (count == 0) continue;
-			const long I = static_cast<long>(system.node[a]);
-			for (int slot = 0; slot < blockSlots; ++slot) {
-				Real value = 0;
-				for (int k = 0; k < count; ++k) value += reached[static_cast<std::size_t>(k)][slot], reached[static_cast<std::size_t>(k)][slot] = 0;
-				if (value != 0) pairs.push_back(PressureSystem::NodePair { a, static_cast<std::size_t>(system.row[static_cast<std::size_t>(I + step[slot])]), value });
+		// the rows with blocks, shared evenly among the threads, each emitting into its own list; the
+		// lists joined in thread order keep the pairs in row order
+		std::vector<std::size_t> withBlocks;
+		for (std::size_t a = 0; a < active; ++a)
+			for (int t = 0; t < threads; ++t)
+				if (system.pairBlockOf[static_cast<std::size_t>(t)][a] >= 0) {
+					withBlocks.push_back(a);
+					break;
+				}
+		const int emitThreads = withBlocks.size() < parallelSurfaceNodes ? 1 : omp_get_max_threads();
+		system.emittedPairs.resize(static_cast<std::size_t>(emitThreads));
+#pragma omp parallel num_threads(emitThreads)
+		{
+			std::vector<PressureSystem::NodePair>& mine = system.emittedPairs[static_cast<std::size_t>(omp_get_thread_num())];
+			mine.clear();
+			std::vector<Real*> reached(static_cast<std::size_t>(threads));
+#pragma omp for schedule(static)
+			for (std::size_t k = 0; k < withBlocks.size(); ++k) {
+				const std::size_t a     = withBlocks[k];
+				int               count = 0;
+				for (int t = 0; t < threads; ++t) {
+					const int b = system.pairBlockOf[static_cast<std::size_t>(t)][a];
+					if (b >= 0) reached[static_cast<std::size_t>(count++)] = system.pairBlocks[static_cast<std::size_t>(t)].data() + static_cast<std::size_t>(b) * blockSlots;
+				}
+				const long I = static_cast<long>(system.node[a]);
+				for (int slot = 0; slot < blockSlots; ++slot) {
+					Real value = 0;
+					for (int q = 0; q < count; ++q) value += reached[static_cast<std::size_t>(q)][slot], reached[static_cast<std::size_t>(q)][slot] = 0;
+					if (value != 0) mine.push_back(PressureSystem::NodePair { a, static_cast<std::size_t>(system.row[static_cast<std::size_t>(I + step[slot])]), value });
+				}
 			}
 		}
+		for (const std::vector<PressureSystem::NodePair>& more : system.emittedPairs) pairs.insert(pairs.end(), more.begin(), more.end());
 	}
 
 	template <class Kernel>

@@ -109,6 +109,7 @@ struct PressureSystem {
 	std::vector<std::vector<Real>>                sampledSupportBuffers;                // (same), per extra thread
 	std::vector<std::vector<Real>>                pairBlocks;       // (same), per thread: per row they reach, its pairs by offset (365 slots: (−4…4)³ after the row's node); zero between steps
 	std::vector<std::vector<int>>                 pairBlockOf;      // (same), per thread: per row, its block in pairBlocks, −1: none
+	std::vector<std::vector<NodePair>>            emittedPairs;     // (same), per thread: the pairs of its share of the rows
 	std::vector<FreePair> pairScratch;                              // buildPressureMatrix's scratch, kept from step to step
 	std::vector<int>      rowCount, cursorScratch, columnScratch; // (same)
 	std::vector<Real>     valueScratch;                           // (same)
