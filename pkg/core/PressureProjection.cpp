@@ -559,6 +559,11 @@ namespace stages {
 		if (!std::is_sorted(extra.begin(), extra.end(), byRowThenColumn)) std::sort(extra.begin(), extra.end(), byRowThenColumn);
 		std::size_t next = 0;
 		for (std::size_t r = 0; r < active; ++r) {
+			// a row held at p = 0 and tied to no unknown adds exactly zero through each of its pairs
+			if (unknownOf[r] < 0 && system.fixedValue[r] == 0) {
+				while (next < extra.size() && extra[next].row == r) ++next;
+				continue;
+			}
 			const Real*              k   = system.rows.data() + r * PressureSystem::rowStride;
 			const std::array<int, 3> idx = grid.indices(system.node[r]);
 			for (int o = centreSlot; o < PressureSystem::offsets; ++o) {
@@ -583,12 +588,11 @@ namespace stages {
 			column[cursor[e.row]] = e.column, value[cursor[e.row]++] = e.value;
 			if (e.column != e.row) column[cursor[e.column]] = e.row, value[cursor[e.column]++] = e.value;
 		}
-		// sort and merge in place the rows out of order (a tied node's, a wrapped periodic axis's); `merged` keeps the new lengths
+		// sort and merge in place the rows out of order (a tied node's, a wrapped periodic axis's); `merged`
+		// keeps the new lengths. Such a row is a few runs in order: an insertion sort (stable, so equal
+		// columns are summed in the order they came) moves only the entries out of place
 		std::vector<int>& merged = system.cursorScratch;
-#pragma omp parallel if(n > static_cast<int>(parallelThreshold))
-		{
-		std::vector<std::pair<int, Real>> row;
-#pragma omp for schedule(static)
+#pragma omp parallel for schedule(static) if(n > static_cast<int>(parallelThreshold))
 		for (int u = 0; u < n; ++u) {
 			const int first = count[u], last = count[u + 1];
 			bool      sorted = true;
@@ -597,16 +601,19 @@ namespace stages {
 				merged[u] = last - first;
 				continue;
 			}
-			row.clear();
-			for (int e = first; e < last; ++e) row.emplace_back(column[e], value[e]);
-			std::sort(row.begin(), row.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+			for (int e = first + 1; e < last; ++e) {
+				const int  col = column[e];
+				const Real v   = value[e];
+				int        j   = e;
+				for (; j > first && column[j - 1] > col; --j) column[j] = column[j - 1], value[j] = value[j - 1];
+				column[j] = col, value[j] = v;
+			}
 			int m = 0;
-			for (const auto& [col, v] : row) {
-				if (m > 0 && column[first + m - 1] == col) value[first + m - 1] += v;
-				else column[first + m] = col, value[first + m] = v, ++m;
+			for (int e = first; e < last; ++e) {
+				if (m > 0 && column[first + m - 1] == column[e]) value[first + m - 1] += value[e];
+				else column[first + m] = column[e], value[first + m] = value[e], ++m;
 			}
 			merged[u] = m;
-		}
 		}
 		Eigen::SparseMatrix<Real, Eigen::RowMajor>& A = system.matrix;
 		A.resize(n, n);
@@ -1009,6 +1016,14 @@ namespace stages {
 				}
 			}
 		}
+		// the rows a pair must join to count: a free row, one the active set may free (`candidate`), one tied
+		// to a free master (eq. 8.5b) or one held at p̄ ≠ 0. A pair with any other row, fixed at p = 0 and
+		// untied in every round, adds exactly zero to K, to the right-hand side and to the excess of the rows the
+		// active set reads (rowExcess): dropping it changes no bit and leaves a fraction of the pairs (a
+		// surface's outer rows are fixed)
+		std::vector<char> live(active, 0);
+		for (std::size_t r = 0; r < active; ++r)
+			live[r] = !system.fixed[r] || candidate[r] || system.fixedValue[r] != 0 || (!system.ghostMaster.empty() && system.ghostMaster[r] >= 0);
 		// eq. 8.5f per candidate I: node I's share of K becomes L_I − Δt λ_I a aᵀ/V^w_I + F_Iᵀ R_I F_I (a
 		// covariance and a Gram matrix: K positive definite by construction), i.e. L plus, per pair (J, K),
 		// value = Σ_d u_K,dᵀ Z_d u_J,d with u_J,d = (Σ_IJ where it counts, g^s_IJ, g^w_IJ) along axis d and
@@ -1032,7 +1047,7 @@ namespace stages {
 				const int x = idx[0] + a, y = idx[1] + b, z = idx[2] + cc;
 				if (x < 0 || y < 0 || z < 0 || x >= grid.nodes[0] || y >= grid.nodes[1] || z >= grid.nodes[2]) continue;
 				const int row = system.row[grid.index(x, y, z)];
-				if (row < 0) continue;
+				if (row < 0 || !live[static_cast<std::size_t>(row)]) continue;
 				const Coupling& J       = coupling[c][o];
 				const bool      counts  = J.surface.norm() > negligible;
 				rowOf[m]                = row;
