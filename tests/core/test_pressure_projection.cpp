@@ -105,12 +105,18 @@ TEST(PressureSystem, MatrixIsSymmetricWithAPositiveDiagonal)
 // of K and factors the pair terms by axis (issue 18); its CSR matrix must equal this sum to
 // round-off, with the prescribed columns moved to the right-hand side: b_I − Σ_J K_IJ p̄_J. On a
 // periodic axis of 3 cells two stencil offsets reach one node, and their entries must add up.
-void expectMatrixIsThePairSum(bool periodicX)
+// With extra pairs (the capillary surface's terms, eq. 8.5f: PressureSystem::extraPairs, one entry per
+// unordered pair, some on a stored pair's column, some up to 4 cells apart, given out of order), each
+// adds its value to K_IJ and K_JI and the matrix must still be that sum.
+void expectMatrixIsThePairSum(bool periodicX, bool extraPairs = false)
 {
 	const Real         h = 0.1, dt = 1e-3;
 	const GridGeometry grid = GridGeometry::forDomain(Vec3::Zero(), Vec3(0.3, 0.3, 0.4), h, { periodicX, false, false });
 	GridFields         fields;
 	fields.resize(grid.nodeCount());
+	// the predicted velocities the right-hand side reads (the predictor's, not run here): at rest
+	std::fill(fields.solidVelocityNew.begin(), fields.solidVelocityNew.end(), Vec3::Zero());
+	std::fill(fields.waterVelocityNew.begin(), fields.waterVelocityNew.end(), Vec3::Zero());
 	std::mt19937_64                      rng(11);
 	std::uniform_real_distribution<Real> ux(periodicX ? 0.0 : 0.03, periodicX ? 0.3 : 0.27), uy(0.03, 0.27), uz(0.03, 0.33), unit(-1, 1), len(0.015, 0.025);
 	SolidPointSet                        solid;
@@ -158,9 +164,31 @@ void expectMatrixIsThePairSum(bool periodicX)
 		heldSolid.push_back({ I % 2 == 1, false, I % 4 == 1 });
 	}
 	stages::assemblePressureSystem<GimpKernel>(grid, fields, solids, waters, water, held, heldSolid, dt, 1e-12, 1e-12, system);
+	std::map<std::pair<std::size_t, std::size_t>, Real> K; // grid nodes (I, J) → K_IJ
+	if (extraPairs) {
+		const std::size_t active = system.node.size();
+		std::uniform_int_distribution<std::size_t> anyRow(0, active - 1);
+		std::uniform_int_distribution<int>         offset(-4, 4);
+		for (int e = 0; e < 3000; ++e) {
+			const std::size_t        r  = anyRow(rng);
+			const std::array<int, 3> id = grid.indices(system.node[r]);
+			const int x = id[0] + offset(rng), y = id[1] + offset(rng), z = id[2] + offset(rng);
+			if (x < 0 || y < 0 || z < 0 || x >= grid.nodes[0] || y >= grid.nodes[1] || z >= grid.nodes[2]) continue;
+			const int c = system.row[grid.index(x, y, z)];
+			if (c < 0) continue;
+			const std::size_t first = std::min<std::size_t>(r, static_cast<std::size_t>(c)), second = std::max<std::size_t>(r, static_cast<std::size_t>(c));
+			bool repeated = false; // one entry per pair, as meniscusPairs emits them
+			for (const auto& pair : system.extraPairs) repeated = repeated || (pair.row == first && pair.column == second);
+			if (repeated) continue;
+			const Real value = 1e-3 * unit(rng) * system.rows[first * PressureSystem::rowStride + 0]; // of the size of a diagonal
+			system.extraPairs.push_back(PressureSystem::NodePair { first, second, value });
+			K[{ system.node[first], system.node[second] }] += value;
+			if (first != second) K[{ system.node[second], system.node[first] }] += value;
+		}
+		ASSERT_GT(system.extraPairs.size(), 200u);
+	}
 	stages::buildPressureMatrix(grid, system);
 
-	std::map<std::pair<std::size_t, std::size_t>, Real> K; // grid nodes (I, J) → K_IJ
 	for (std::size_t p = 0; p < fluid.size(); ++p) {
 		Weights1D w[3];
 		detail::weightsAt<GimpKernel>(grid, fluid.position[p], fluid.halfLength[p], w);
@@ -227,6 +255,8 @@ void expectMatrixIsThePairSum(bool periodicX)
 
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinition) { expectMatrixIsThePairSum(false); }
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionAcrossAPeriodicSeamOfThreeCells) { expectMatrixIsThePairSum(true); }
+TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionWithExtraPairsOutOfOrder) { expectMatrixIsThePairSum(false, true); }
+TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionWithExtraPairsAcrossAPeriodicSeam) { expectMatrixIsThePairSum(true, true); }
 
 // Eqs. 8.5b and 8.5d: a surface that slopes across the grid. Free water fills a box below the plane
 // z = z0 + x tan γx + y tan γy (water points on a lattice of m per cell and axis, kept where the centre
