@@ -969,40 +969,40 @@ namespace stages {
 				myShare.assign(candidates.size(), 0);
 			}
 #pragma omp for schedule(static)
-				for (std::size_t k = 0; k < touching.size(); ++k) {
-					const WaterPointSet& P = *touching[k].first;
-					const std::size_t    p = touching[k].second;
-					Weights1D w[3];
-					weightsAt<Kernel>(grid, P, p, w);
-					std::size_t I[S * S * S];
-					Real        N[S * S * S];
-					Vec3        dN[S * S * S];
-					int         m       = 0;
-					Real        n       = 0;
-					forEachNode<Kernel>(grid, w, [&](std::size_t J, Real NJ, const Vec3& dNJ) {
-						I[m] = J, N[m] = NJ, dN[m] = dNJ, ++m;
-						n += NJ * fields.porosity[J];
-					});
-					n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
-					const Real V = P.volume[p];
-					std::array<int, 3> at[S * S * S];
-					for (int a = 0; a < m; ++a) at[a] = grid.indices(I[a]);
-					for (int a = 0; a < m; ++a) {
-						if (slotOf[I[a]] < 0) continue;
-						auto& c = mine[static_cast<std::size_t>(slotOf[I[a]])];
-						myShare[static_cast<std::size_t>(slotOf[I[a]])] += V * N[a];
-						const std::array<int, 3>& ia = at[a];
-						for (int b = 0; b < m; ++b) {
-							const std::array<int, 3>& ib = at[b];
-							const int dx = ib[0] - ia[0], dy = ib[1] - ia[1], dz = ib[2] - ia[2];
-							if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap (refused at setup)
-							Coupling& e = c[offsetSlot(dx, dy, dz)];
-							e.surface += V * (N[b] * dN[a] + N[a] * dN[b]);
-							e.solid -= V * (1 - n) * N[a] * dN[b];
-							e.water -= V * n * N[a] * dN[b];
-						}
+			for (std::size_t k = 0; k < touching.size(); ++k) {
+				const WaterPointSet& P = *touching[k].first;
+				const std::size_t    p = touching[k].second;
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P, p, w);
+				std::size_t I[S * S * S];
+				Real        N[S * S * S];
+				Vec3        dN[S * S * S];
+				int         m       = 0;
+				Real        n       = 0;
+				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real NJ, const Vec3& dNJ) {
+					I[m] = J, N[m] = NJ, dN[m] = dNJ, ++m;
+					n += NJ * fields.porosity[J];
+				});
+				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
+				const Real V = P.volume[p];
+				std::array<int, 3> at[S * S * S];
+				for (int a = 0; a < m; ++a) at[a] = grid.indices(I[a]);
+				for (int a = 0; a < m; ++a) {
+					if (slotOf[I[a]] < 0) continue;
+					auto& c = mine[static_cast<std::size_t>(slotOf[I[a]])];
+					myShare[static_cast<std::size_t>(slotOf[I[a]])] += V * N[a];
+					const std::array<int, 3>& ia = at[a];
+					for (int b = 0; b < m; ++b) {
+						const std::array<int, 3>& ib = at[b];
+						const int dx = ib[0] - ia[0], dy = ib[1] - ia[1], dz = ib[2] - ia[2];
+						if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap (refused at setup)
+						Coupling& e = c[offsetSlot(dx, dy, dz)];
+						e.surface += V * (N[b] * dN[a] + N[a] * dN[b]);
+						e.solid -= V * (1 - n) * N[a] * dN[b];
+						e.water -= V * n * N[a] * dN[b];
 					}
 				}
+			}
 		}
 		for (int t = 1; t < pointThreads; ++t) {
 			const auto& more  = system.surfaceCouplingBuffers[static_cast<std::size_t>(t - 1)];

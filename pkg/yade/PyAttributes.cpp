@@ -89,8 +89,9 @@ std::string layoutMismatch(const std::string& className, const std::string& save
 			if (std::find(in.begin(), in.end(), w) == in.end()) list += (list.empty() ? "" : ", ") + w;
 		return list.empty() ? std::string("none") : list;
 	};
-	return className + " was saved by another yade-mpm: its saved attributes differ from this build's (only in the save: " + missingFrom(was, is) +
-	       "; only in this build: " + missingFrom(is, was) + (missingFrom(was, is) == "none" && missingFrom(is, was) == "none" ? "; same names in another order" : "") +
+	const std::string onlySaved = missingFrom(was, is), onlyHere = missingFrom(is, was);
+	return className + " was saved by another yade-mpm: its saved attributes differ from this build's (only in the save: " + onlySaved +
+	       "; only in this build: " + onlyHere + (onlySaved == "none" && onlyHere == "none" ? "; same names in another order" : "") +
 	       "): they cannot be matched; rebuild the scene with this version's script";
 }
 
