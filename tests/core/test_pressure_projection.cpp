@@ -1,6 +1,7 @@
 // Operators of the semi-implicit pressure projection (doc/theory.md §8.2): the mobility λ of eq. 8.5
 // against the 2×2 nodal system it condenses, and its limits; the assembled matrix against the
 // definition of K summed pair by pair.
+#include "core/Errors.hpp"
 #include "core/PressureProjection.hpp"
 #include "core/Stencil.hpp"
 #include "core/TwoPhaseSolver.hpp"
@@ -8,9 +9,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <random>
+#include <string>
 
 namespace {
 
@@ -97,6 +101,55 @@ TEST(PressureSystem, MatrixIsSymmetricWithAPositiveDiagonal)
 	std::printf("K: %ld unknowns, %ld non-zeros, |K - Kᵀ| / |K| = %.2e\n", static_cast<long>(K.rows()), static_cast<long>(K.nonZeros()), asymmetry / size);
 	EXPECT_LT(asymmetry, 1e-14 * size);
 	for (long r = 0; r < K.rows(); ++r) EXPECT_GT(K.coeff(r, r), 0) << "row " << r;
+}
+
+// rowExcess (the seepage face's active set reads every row's b − K p, eq. 8.5f) on a system with one
+// non-finite entry: it stops with an InstabilityError naming the node's place, instead of reading on. Read
+// on, a NaN entry paired its node with one that has no row and the excess was written before its array
+// (valgrind: an invalid write 8 bytes before the block; the heap corruption behind a `double free` that
+// once ended a laboratory sand-pile run). On the same system unpoisoned, the excess of a free row is its
+// residual, ≈ 0 after the solve (the solve's own check), and it is finite everywhere.
+TEST(PressureSystem, RowExcessRefusesANonFiniteEntryInsteadOfReadingOn)
+{
+	const double    h = 0.05;
+	SoilParameters  soil;
+	WaterParameters water;
+	const auto      l     = fixtures::lattice(Vec3::Zero(), Vec3(4 * h, 3 * h, 5 * h), h, 2);
+	SolidPointSet   solid = fixtures::solidLattice(l, soil.porosity, soil.density);
+	WaterPointSet   fluid = fixtures::waterLattice(l, soil.porosity, water.density);
+	Domain          d     = fixtures::columnDomain(Vec3(4 * h, 3 * h, 7 * h), h);
+	d.boundaries.walls[static_cast<int>(Face::XMax)] = { SolidWall::Slip, WaterWall::Drained };
+	SolverSettings s;
+	s.gravity = Vec3(0, 0, -9.81);
+	TwoPhaseSolver solver(d, s);
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	solver.step(0.5 * solver.timeStepLimits().critical);
+	PressureSystem    system = solver.pressureSystem();
+	const auto        excess = stages::rowExcess(solver.grid(), system);
+	double            largest = 0, freeResidual = 0;
+	for (std::size_t r = 0; r < excess.size(); ++r) {
+		ASSERT_TRUE(std::isfinite(excess[r])) << "row " << r;
+		largest = std::max(largest, std::abs(excess[r]));
+		if (!system.fixed[r]) freeResidual = std::max(freeResidual, std::abs(excess[r]));
+	}
+	ASSERT_GT(largest, 0);
+	EXPECT_LT(freeResidual, 1e-6 * largest); // the free rows' equations hold; the excess sits on the prescribed ones
+	// a prescribed row (the drained face's) as the solve does not read it: poison its diagonal
+	std::size_t poisoned = system.node.size();
+	for (std::size_t r = 0; r < system.node.size() && poisoned == system.node.size(); ++r)
+		if (system.fixed[r] && system.rows[r * PressureSystem::rowStride] != 0) poisoned = r;
+	ASSERT_LT(poisoned, system.node.size());
+	system.rows[poisoned * PressureSystem::rowStride] = std::numeric_limits<double>::quiet_NaN();
+	try {
+		stages::rowExcess(solver.grid(), system);
+		FAIL() << "a NaN in K was read on";
+	} catch (const InstabilityError& e) {
+		EXPECT_NE(std::string(e.what()).find("not finite"), std::string::npos) << e.what();
+		EXPECT_NE(std::string(e.what()).find("pressure node at ("), std::string::npos) << e.what();
+	}
+	system.rows[poisoned * PressureSystem::rowStride] = 0;
+	system.rows[poisoned * PressureSystem::rowStride + PressureSystem::rhsSlot] = std::numeric_limits<double>::infinity();
+	EXPECT_THROW(stages::rowExcess(solver.grid(), system), InstabilityError);
 }
 
 // K of eq. 8.7 by its definition (eqs. 8.3, 8.6), pair by pair over the water points:
