@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <memory>
 #include <random>
 #include <string>
 
@@ -78,23 +79,35 @@ TEST(Corrector, IncrementsSolveTheNodalDragSystemAndItsLimits)
 
 // K = C/Δt + Δt L (eq. 8.7) is symmetric and has a positive diagonal, on a scene with walls, a
 // drained face, a free surface and points off the lattice (a block after some steps of settling).
+// A saturated block 4 × 3 × 5 cells under gravity, two empty cells above it (a free surface), its
+// xMax face drained: a pressure system with free, prescribed and surface rows, after `steps` steps.
+struct DrainedBlock {
+	static constexpr double         h = 0.05;
+	SoilParameters                  soil;
+	WaterParameters                 water;
+	SolidPointSet                   solid;
+	WaterPointSet                   fluid;
+	std::unique_ptr<TwoPhaseSolver> solver;
+	explicit DrainedBlock(int steps)
+	{
+		const auto l = fixtures::lattice(Vec3::Zero(), Vec3(4 * h, 3 * h, 5 * h), h, 2);
+		solid        = fixtures::solidLattice(l, soil.porosity, soil.density);
+		fluid        = fixtures::waterLattice(l, soil.porosity, water.density);
+		Domain d     = fixtures::columnDomain(Vec3(4 * h, 3 * h, 7 * h), h);
+		d.boundaries.walls[static_cast<int>(Face::XMax)] = { SolidWall::Slip, WaterWall::Drained };
+		SolverSettings s;
+		s.gravity = Vec3(0, 0, -9.81);
+		solver    = std::make_unique<TwoPhaseSolver>(d, s);
+		solver->setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+		const double dt = 0.5 * solver->timeStepLimits().critical;
+		for (int i = 0; i < steps; ++i) solver->step(dt);
+	}
+};
+
 TEST(PressureSystem, MatrixIsSymmetricWithAPositiveDiagonal)
 {
-	const double    h = 0.05;
-	SoilParameters  soil;
-	WaterParameters water;
-	const auto      l     = fixtures::lattice(Vec3::Zero(), Vec3(4 * h, 3 * h, 5 * h), h, 2);
-	SolidPointSet   solid = fixtures::solidLattice(l, soil.porosity, soil.density);
-	WaterPointSet   fluid = fixtures::waterLattice(l, soil.porosity, water.density);
-	Domain          d     = fixtures::columnDomain(Vec3(4 * h, 3 * h, 7 * h), h); // two empty cells above: a free surface
-	d.boundaries.walls[static_cast<int>(Face::XMax)] = { SolidWall::Slip, WaterWall::Drained };
-	SolverSettings s;
-	s.gravity = Vec3(0, 0, -9.81);
-	TwoPhaseSolver solver(d, s);
-	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
-	const double dt = 0.5 * solver.timeStepLimits().critical;
-	for (int i = 0; i < 20; ++i) solver.step(dt);
-	const auto& K = solver.pressureSystem().matrix;
+	DrainedBlock block(20);
+	const auto&  K = block.solver->pressureSystem().matrix;
 	ASSERT_GT(K.rows(), 0);
 	const Eigen::SparseMatrix<double> A(K), At(A.transpose());
 	const double asymmetry = (A - At).norm(), size = A.norm();
@@ -111,22 +124,11 @@ TEST(PressureSystem, MatrixIsSymmetricWithAPositiveDiagonal)
 // residual, ≈ 0 after the solve (the solve's own check), and it is finite everywhere.
 TEST(PressureSystem, RowExcessRefusesANonFiniteEntryInsteadOfReadingOn)
 {
-	const double    h = 0.05;
-	SoilParameters  soil;
-	WaterParameters water;
-	const auto      l     = fixtures::lattice(Vec3::Zero(), Vec3(4 * h, 3 * h, 5 * h), h, 2);
-	SolidPointSet   solid = fixtures::solidLattice(l, soil.porosity, soil.density);
-	WaterPointSet   fluid = fixtures::waterLattice(l, soil.porosity, water.density);
-	Domain          d     = fixtures::columnDomain(Vec3(4 * h, 3 * h, 7 * h), h);
-	d.boundaries.walls[static_cast<int>(Face::XMax)] = { SolidWall::Slip, WaterWall::Drained };
-	SolverSettings s;
-	s.gravity = Vec3(0, 0, -9.81);
-	TwoPhaseSolver solver(d, s);
-	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
-	solver.step(0.5 * solver.timeStepLimits().critical);
-	PressureSystem    system = solver.pressureSystem();
-	const auto        excess = stages::rowExcess(solver.grid(), system);
-	double            largest = 0, freeResidual = 0;
+	const DrainedBlock    block(1);
+	const TwoPhaseSolver& solver  = *block.solver;
+	PressureSystem        system  = solver.pressureSystem();
+	const auto            excess  = stages::rowExcess(solver.grid(), system);
+	double                largest = 0, freeResidual = 0;
 	for (std::size_t r = 0; r < excess.size(); ++r) {
 		ASSERT_TRUE(std::isfinite(excess[r])) << "row " << r;
 		largest = std::max(largest, std::abs(excess[r]));
