@@ -496,6 +496,23 @@ namespace stages {
 	void buildPressureMatrix(const GridGeometry& grid, PressureSystem& system)
 	{
 		const std::size_t active = system.node.size();
+		// A non-finite entry of any row (the prescribed rows too: rowExcess reads them) or extra pair
+		// stops the step with its place. Read on, a non-zero entry is taken for a pair of two rows: the
+		// NaN's partner had none, and rowExcess wrote before its array (the heap corruption behind a
+		// `double free` that once ended a sand-pile run). Once per build; the rows do not change after it.
+		auto refuse = [&](std::size_t r, const char* what) {
+			const std::array<int, 3> at = grid.indices(system.node[r]);
+			const Vec3               x  = grid.nodePosition(at[0], at[1], at[2]);
+			std::ostringstream       msg;
+			msg << "the pore-pressure system's " << what << " at the pressure node at (" << x[0] << ", " << x[1] << ", " << x[2]
+			    << ") m is not finite (an unstable state: check the time step and the boundary conditions there)";
+			throw InstabilityError(msg.str());
+		};
+		for (std::size_t r = 0; r < active; ++r)
+			for (int slot = 0; slot < PressureSystem::rowStride; ++slot)
+				if (!std::isfinite(system.rows[r * PressureSystem::rowStride + slot])) refuse(r, slot == PressureSystem::rhsSlot ? "right-hand side" : "matrix row");
+		for (const PressureSystem::NodePair& e : system.extraPairs)
+			if (!std::isfinite(e.value)) refuse(e.row, "surface term (eq. 8.5f)");
 		// A node that points reach only by the round-off tail of their weights (a point whose domain
 		// ends exactly at a node plane) carries no equation worth the name: its coupling is ~1e-16 of
 		// the others and would ruin the conditioning. Such a node, and one no point's gradient reaches
@@ -868,19 +885,6 @@ namespace stages {
 		const std::size_t active = system.node.size();
 		std::vector<Real> excess(active, 0);
 		for (std::size_t r = 0; r < active; ++r) excess[r] = system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
-		// a non-finite entry (of any row: the prescribed rows are read here too, not only by the solve)
-		// stops the step with its place; read on, it made a pair with a node that has no row and wrote
-		// before the array (the heap corruption behind a `double free` that once ended a sand-pile run)
-		auto refuse = [&](std::size_t r, const char* what) {
-			const std::array<int, 3> at = grid.indices(system.node[r]);
-			const Vec3               x  = grid.nodePosition(at[0], at[1], at[2]);
-			std::ostringstream       msg;
-			msg << "the pore-pressure system's " << what << " at the pressure node at (" << x[0] << ", " << x[1] << ", " << x[2]
-			    << ") m is not finite (an unstable state: check the time step and the boundary conditions there)";
-			throw InstabilityError(msg.str());
-		};
-		for (std::size_t r = 0; r < active; ++r)
-			if (!std::isfinite(excess[r])) refuse(r, "right-hand side");
 		// each stored pair (r, J) of the upper half gives K_rJ p_J to row r and K_Jr p_r to row J
 		for (std::size_t r = 0; r < active; ++r) {
 			const Real*              k   = system.rows.data() + r * PressureSystem::rowStride;
@@ -889,11 +893,9 @@ namespace stages {
 			for (int o = centreSlot; o < PressureSystem::offsets; ++o) {
 				const Real value = k[o - centreSlot];
 				if (value == 0) continue;
-				if (!std::isfinite(value)) refuse(r, "matrix row");
 				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, c = o / 25 - 2;
 				const std::size_t J  = grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c));
 				const int         rJ = system.row[J];
-				if (rJ < 0) continue; // a finite pair always joins two rows (both nodes lie in one point's stencil)
 				excess[r] -= value * system.nodalPressure[J];
 				if (o != centreSlot) excess[static_cast<std::size_t>(rJ)] -= value * pr;
 			}

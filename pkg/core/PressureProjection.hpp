@@ -154,7 +154,8 @@ namespace stages {
 
 	// b − K p per pressure node from the stored rows and system.nodalPressure (every node's row, fixed
 	// or free, the plate's rank-one term left out): zero on a free row at convergence; on a prescribed
-	// one the volume rate its tent must shed through the boundary [m³ s⁻¹].
+	// one the volume rate its tent must shed through the boundary [m³ s⁻¹]. On rows buildPressureMatrix
+	// has checked finite.
 	std::vector<Real> rowExcess(const GridGeometry& grid, const PressureSystem& system);
 
 	// The surface nodes' terms of K (theory.md eqs. 8.5e–f): for each pressure node I with `candidate`
@@ -176,7 +177,8 @@ namespace stages {
 	                           const ConstrainedNodes& constrained, const PlateMotion& plate, Real dt, PressureSystem& system);
 
 	// The free rows of eq. 8.7 as a sparse (CSR) matrix and right-hand side, the prescribed
-	// pressures moved to the right-hand side: what a linear solver needs, nothing of the grid.
+	// pressures moved to the right-hand side: what a linear solver needs, nothing of the grid. Throws
+	// InstabilityError, naming the node's place, if any stored entry or extra pair is not finite.
 	void buildPressureMatrix(const GridGeometry& grid, PressureSystem& system);
 
 	// Solve eq. 8.7 for the free nodal pressures with Eigen's conjugate gradient,
