@@ -84,6 +84,10 @@ parser.add_argument("--lid-friction", type=float, default=0.0,
 parser.add_argument("--base", choices=("frictional", "fixed"), default="frictional",
                     help="the flume base: a Coulomb contact with the scene's base friction angle (default), or fixed (no slip, no lift-off)")
 parser.add_argument("--head-start", type=float, help="inflow water level at the start, also the pile's starting water table [m] (default the scene's 0.03 m)")
+parser.add_argument("--start-table", choices=("steady", "level"), default="steady",
+                    help="the pile's starting water table: 'steady' (default), the phreatic surface of steady seepage under the "
+                         "starting head (Dupuit, yade_mpm.sandpile.SandPileScene.starting_water_table), or 'level', level at the "
+                         "starting head through the whole pile (near the toe above the ground: the pile starts draining)")
 parser.add_argument("--water-bulk-modulus", type=float, metavar="KW",
                     help="the water's bulk modulus Kw [Pa] (default the scene's: 2.2e8, lowered for the explicit step, which follows "
                          "the undrained wave; --submerged 2.2e9, real water, which the semi-implicit step affords)")
@@ -204,7 +208,8 @@ solid_body, water_body = yade_mpm.saturated_points(positions, spacing, soil, wat
                                                    surface=SCENE.surface_height(positions[:, 0]),
                                                    lateral_earth_pressure=1 - math.sin(SCENE.friction_angle),
                                                    **(dict(still_water_level=SCENE.still_water_level) if SUBMERGED else
-                                                      dict(water_table=SCENE.head_start, suction_above_table=SUCTION_ABOVE_TABLE,
+                                                      dict(water_table=(SCENE.starting_water_table(positions[:, 0]) if args.start_table == "steady" else SCENE.head_start),
+                                                           suction_above_table=SUCTION_ABOVE_TABLE,
                                                            dry_above_table=not SUCTION_ABOVE_TABLE)))
 O.bodies.append([solid_body, water_body])
 solid, fluid = solid_body.shape, water_body.shape
@@ -447,6 +452,7 @@ summary = {
     "solid_points": int(solid.count),
     "water_points_end": int(fluid.count),
     "scene": {k: getattr(SCENE, k) for k in SCENE.__dataclass_fields__},
+    "start_table": "still water level" if SUBMERGED else args.start_table,
     "sand_strength_source": SAND_SOURCE,
     "side_wall_friction": args.side_wall_friction,
     "gravity_m_per_s2": GRAVITY.tolist(),

@@ -62,8 +62,9 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
 
     With gravity (b_z < 0) and `surface` (N elevations of the ground surface above each point [m]),
     the start is geostatic: hydrostatic pore pressure p = ρw |b_z| (table − z) below `water_table`
-    [m], σ′_zz = −(ρsat |b_z| (surface − z) − p), σ′_xx = σ′_yy = K0 σ′_zz with K0 =
-    `lateral_earth_pressure` (default ν/(1−ν)). Above the table p = 0, or with
+    [m] (one elevation, or N of them: the table above each point, e.g. a steady phreatic surface in
+    Dupuit's approximation), σ′_zz = −(ρsat |b_z| (surface − z) − p), σ′_xx = σ′_yy = K0 σ′_zz with
+    K0 = `lateral_earth_pressure` (default ν/(1−ν)). Above the table p = 0, or with
     `suction_above_table` the hydrostatic suction p = −ρw |b_z| (z − table) of soil held saturated
     by capillarity. A tilted gravity (b_x, b_y ≠ 0) makes the ground an infinite slope with z its
     normal: the skeleton carries the downslope weight of the whole mixture in shear,
@@ -109,12 +110,19 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
         if surface is None or (water_table is None and still_water_level is None):
             raise ValueError("a geostatic start needs the ground surface and the water table elevations [m]")
         surface = np.broadcast_to(np.asarray(surface, dtype=float), (count,))
+        table = None
+        if water_table is not None:
+            table = np.asarray(water_table, dtype=float)
+            if table.shape not in ((), (count,)) or not np.isfinite(table).all():
+                raise ValueError("water_table must be one finite elevation or %d (one per point) [m]; got shape %r%s"
+                                 % (count, table.shape, "" if np.isfinite(table).all() else " with non-finite values"))
+            table = np.broadcast_to(table, (count,))
         rho_w = water.density
         rho_sat = (1 - n0) * soil.density + n0 * rho_w
         if still_water_level is None:
             # hydrostatic pore pressure below the water table; above it none, or the capillary suction
             # that holds the water at rest; the skeleton carries the total weight less the pore pressure
-            pore_pressure = rho_w * g * (float(water_table) - z)
+            pore_pressure = rho_w * g * (table - z)
             if not suction_above_table:
                 pore_pressure = np.clip(pore_pressure, 0, None)
         if still_water_level is not None:
@@ -124,7 +132,6 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
             if suction_above_table or gravity[:2].any():
                 raise ValueError("dry_above_table needs level gravity and no suction_above_table")
             rho_dry = (1 - n0) * soil.density
-            table = float(water_table)
             total = g * (rho_dry * np.clip(surface - np.maximum(z, table), 0, None) + rho_sat * np.clip(np.minimum(surface, table) - z, 0, None))
             vertical = -(total - pore_pressure)
         else:
@@ -147,7 +154,7 @@ def saturated_points(positions, spacing, soil, water, gravity=(0.0, 0.0, 0.0), s
     solid.porosity = np.full(count, n0)
     solid.stress = stress
 
-    wet = np.ones(count, dtype=bool) if not (dry_above_table and g > 0) else z < float(water_table)
+    wet = np.ones(count, dtype=bool) if not (dry_above_table and g > 0) else z < table
     fluid = _w.MpmWaterPoints(pos=positions[wet])
     fluid.mass = n0 * water.density * volume[wet]
     fluid.volume = volume[wet]

@@ -81,6 +81,23 @@ class SandPileScene:
         down = self.pile_height - (x - self.crest_length) * math.tan(self.slope_angle)
         return np.where(x <= self.crest_length, self.pile_height, np.clip(down, 0, None))
 
+    def starting_water_table(self, x):
+        """The phreatic surface of steady seepage under the starting head [m] at x [m], in Dupuit's
+        approximation (Dupuit 1863, Forchheimer 1886; e.g. Harr, Groundwater and Seepage, 1962, §2):
+        unconfined flow over the impermeable base from the inflow face (head_start at x = 0) to the
+        toe, where the water leaves onto the dry flume (tail water 0): h² = h0² (1 − x/L), L = toe_x,
+        independent of the conductivity; below the ground surface (the seepage face near the toe,
+        where h would stand above the slope), and none beyond the toe. With still water the table is
+        the level (no seepage at the start). This is the state the pile is in once the starting head
+        has been held long enough, which the horizontal table at head_start is not: near the toe, where
+        the ground lies below head_start, that table puts positive pore pressure on a drained surface,
+        and the pile starts draining at an exit gradient above one (doc/sandpile.md)."""
+        x = np.asarray(x, dtype=float)
+        if self.still_water_level is not None:
+            return np.full(x.shape, float(self.still_water_level))
+        dupuit = self.head_start * np.sqrt(np.clip(1 - x / self.toe_x(), 0, None))
+        return np.minimum(dupuit, self.surface_height(x))
+
     def probe_points(self, flume_width=None):
         """Pore-pressure probes {name: (x, y, z)} [m] at mid-width (of `flume_width`, default the
         flume's): upstream, at the crest's edge, mid-slope and near the toe, 2 cm (the toe's 1 cm)

@@ -454,6 +454,31 @@ def test_dry_above_table_start_is_geostatic():
     assert np.allclose(fluid.porePressure, 1000 * g * (table - fluid.pos[:, 2]), rtol=1e-12)
 
 
+def test_sloping_table_per_point_start_is_geostatic_and_bad_tables_are_refused():
+    """saturated_points with one water-table elevation per point (a steady phreatic surface): each
+    point's p = ρw g (table_i − z_i) below its table, dry (no water point) above it with
+    dry_above_table, and σ′_zz the column's weight less p as for a level table; a table of the wrong
+    length or with a NaN is refused by name before anything is built."""
+    soil = w.MpmSoilMat(density=2650, youngModulus=1e7, poissonRatio=0.3, porosity=0.4, intrinsicPermeability=1e-10)
+    water = w.MpmWaterMat(density=1000, bulkModulus=2.2e9, viscosity=1e-3)
+    positions, spacing = yade_mpm.builders._lattice((0, 0, 0), (0.4, 0.05, 0.2), 0.05, 2)
+    height = np.full(len(positions), 0.2)
+    table = 0.15 - 0.25 * positions[:, 0]  # 0.15 m at x = 0 down to 0.05 m at x = 0.4 m
+    g = 9.81
+    _, fluid_body = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=(0, 0, -g), surface=height, water_table=table,
+                                              dry_above_table=True)
+    wet = positions[:, 2] < table
+    assert fluid_body.shape.count == int(wet.sum()) > 0
+    assert np.allclose(fluid_body.shape.porePressure, 1000 * g * (table[wet] - positions[wet, 2]), rtol=1e-12)
+    solid_body, _ = yade_mpm.saturated_points(positions, spacing, soil, water, gravity=(0, 0, -g), surface=height, water_table=table)
+    rho_sat = 0.6 * 2650 + 0.4 * 1000
+    expected = -(rho_sat * g * (height - positions[:, 2]) - np.clip(1000 * g * (table - positions[:, 2]), 0, None))
+    assert np.allclose(solid_body.shape.stress[:, 2, 2], expected, rtol=1e-12, atol=1e-9)
+    for bad in (table[:-1], np.where(positions[:, 0] > 0.2, np.nan, table)):
+        with pytest.raises(ValueError, match="water_table"):
+            yade_mpm.saturated_points(positions, spacing, soil, water, gravity=(0, 0, -g), surface=height, water_table=bad)
+
+
 @pytest.mark.parametrize("table", [0.3, 0.275])
 def test_phreatic_surface_inside_the_soil_stays_at_rest(table):
     """A column dry above its water table (on a node plane, 0.3 m, and mid-cell, 0.275 m, of 0.5 m; h =

@@ -93,3 +93,25 @@ def test_limit_equilibrium_deeper_minimum_slip_raises_the_factor_of_a_cohesionle
     gravity = (0.0, 0.0, -9.81)
     factors = [sandpile.limit_equilibrium(s, solid, no_water, gravity, cell, spacing, min_depth=d * cell).factor for d in (1, 2, 3)]
     assert factors[0] < factors[1] < factors[2], factors
+
+
+def test_starting_water_table_is_dupuits_steady_surface_below_the_ground():
+    """The pile's starting table (SandPileScene.starting_water_table) is Dupuit's phreatic surface of
+    steady unconfined flow from the starting head at the inflow face to the toe: the head starts at
+    head_start, h² falls linearly to 0 at the toe, so the Dupuit discharge k h |dh/dx| is the same
+    through every section, k h0²/(2L) (continuity); nowhere above the ground (near the toe the ground
+    is the seepage face), 0 beyond the toe; a submerged pile starts level at its still water."""
+    s = sandpile.DEFAULT
+    L, h0 = s.toe_x(), s.head_start
+    x = np.linspace(0, s.flume_length, 2401)
+    h = s.starting_water_table(x)
+    assert h[0] == pytest.approx(h0, rel=1e-15)
+    assert np.all(h <= s.surface_height(x) + 1e-15) and np.all(h[x >= L] == 0)
+    below = (h < s.surface_height(x) - 1e-9) & (x < L - 1e-3)
+    assert below.sum() > 0.9 * (x < L - 1e-3).sum()  # the ground caps only the last few millimetres
+    # h² = h0² (1 − x/L): d(h²)/dx = −h0²/L, so the discharge per unit conductivity h |dh/dx| = h0²/(2L) everywhere
+    assert np.allclose(h[below] ** 2, h0 ** 2 * (1 - x[below] / L), rtol=1e-12, atol=0)
+    # the level table at head_start lies above the ground near the toe: what the steady one removes
+    assert np.any(h0 > s.surface_height(x[x < L]))
+    sub = sandpile.SUBMERGED
+    assert np.all(sub.starting_water_table(x) == sub.still_water_level)
