@@ -87,6 +87,17 @@ struct BoundaryConditions {
 		}
 		return false;
 	}
+	// Whether x lies less than one cell inside a face with waterInflow and below that face's water table:
+	// where the reservoir fills the pores (theory.md eq. 8.9c); above its level the face meets air.
+	bool fedByInflowFace(const GridGeometry& grid, const Vec3& x, const Vec3& gravity) const
+	{
+		for (int f = 0; f < faceCount; ++f) {
+			if (!walls[f].inflow || !walls[f].belowWaterTable(x, gravity)) continue;
+			const int d = f / 2;
+			if ((f % 2 ? grid.upper()[d] - x[d] : x[d] - grid.lower()[d]) < grid.cellSize) return true;
+		}
+		return false;
+	}
 	// Throws InvalidParameter naming the face and the condition if a face of a periodic axis
 	// carries any wall condition (it would be silently ignored).
 	void requireFreePeriodicFaces() const;

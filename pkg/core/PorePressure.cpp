@@ -242,14 +242,14 @@ namespace stages {
 		return firstEmptied < static_cast<long>(count) ? firstEmptied : -1;
 	}
 
-	void fillPoresNextToInflowFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const WaterParameters& water, WaterPointSet& P)
+	void fillPoresNextToInflowFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const WaterParameters& water, const Vec3& gravity, WaterPointSet& P)
 	{
 		if (std::none_of(bcs.walls.begin(), bcs.walls.end(), [](const WallConditions& w) { return w.inflow; })) return;
 		const Real        invKw = 1 / water.bulkModulus; // 0 for incompressible water
 		const std::size_t count = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p)
-			if (bcs.withinACellOfInflowFace(grid, P.position[p])) P.volume[p] = P.mass[p] / (P.porosity[p] * water.density * (1 + P.porePressure[p] * invKw));
+			if (bcs.fedByInflowFace(grid, P.position[p], gravity)) P.volume[p] = P.mass[p] / (P.porosity[p] * water.density * (1 + P.porePressure[p] * invKw));
 	}
 
 	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& P,

@@ -291,13 +291,14 @@ namespace stages {
 		const std::size_t active = system.node.size();
 		system.fixed.assign(active, 0);
 		system.fixedValue.assign(active, 0);
+		system.aboveFaceTable.assign(active, 0);
 		std::vector<char> surface(active, 0); // fixed by the free-surface filling, not by a wall
 		for (std::size_t r = 0; r < active; ++r) {
 			const std::size_t        I   = system.node[r];
 			const std::array<int, 3> idx = grid.indices(I);
 			// wall planes and the padding beyond them: a drained face prescribes p̄(t^{n+1}), a free
 			// water face p = 0 (its natural condition, which the compact operator L does not carry)
-			bool open = false, drained = false;
+			bool open = false, drained = false, aboveTables = true;
 			Real value = 0;
 			for (int axis = 0; axis < 3; ++axis) {
 				if (grid.periodic[axis]) continue;
@@ -305,14 +306,18 @@ namespace stages {
 					if (!grid.atWall(axis, side, idx[axis])) continue;
 					const WallConditions& wall = bcs.walls[2 * axis + side];
 					if (wall.water == WaterWall::Drained) {
-						drained = true;
-						value   = wall.drainedPressureAt(grid.nodePosition(idx[0], idx[1], idx[2]), gravity, waterDensity, bcs.stillWaterLevel);
+						const Vec3 x = grid.nodePosition(idx[0], idx[1], idx[2]);
+						drained      = true;
+						value        = wall.drainedPressureAt(x, gravity, waterDensity, bcs.stillWaterLevel);
+						// p̄ = 0 above the face's table is the air over a reservoir, not water (eq. 8.5g)
+						aboveTables = aboveTables && !wall.belowWaterTable(x, gravity) && wall.drainedPressure == 0 && !std::isfinite(bcs.stillWaterLevel);
 					} else if (wall.water == WaterWall::Free) open = true;
 				}
 			}
 			if (drained) {
-				system.fixed[r]      = 1;
-				system.fixedValue[r] = value;
+				system.fixed[r]          = 1;
+				system.fixedValue[r]     = value;
+				system.aboveFaceTable[r] = aboveTables;
 			} else if (open) {
 				system.fixed[r] = 1;
 			} else {

@@ -275,10 +275,12 @@ namespace stages {
 	// Returns the first point whose volume left (0, ∞) (Δt ∇·v^w ≤ −1), else −1.
 	long updateWaterVolume(const std::vector<Real>& waterDivergence, WaterPointSet& points, Real dt);
 	// Semi-implicit step, next to an inflow face (theory.md eq. 8.9c): the water points whose centre lies
-	// within one cell of a face with waterInflow take the volume of the state, V = m/(n ρw (1 + p/Kw)),
-	// n the step's porosity at the point; the face's nodes keep no volume balance, so there the rate form
-	// would integrate a divergence that nothing holds.
-	void fillPoresNextToInflowFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const WaterParameters& water, WaterPointSet& points);
+	// within one cell of a face with waterInflow, below that face's water table, take the volume of the
+	// state, V = m/(n ρw (1 + p/Kw)), n the step's porosity at the point; the face's nodes there keep no
+	// volume balance, so the rate form would integrate a divergence that nothing holds. Above the table
+	// the face's nodes are the capillary surface's (eq. 8.5g), with a volume balance of their own.
+	void fillPoresNextToInflowFaces(const GridGeometry& grid, const BoundaryConditions& bcs, const WaterParameters& water, const Vec3& gravity,
+	                                WaterPointSet& points);
 
 	// Free surface (theory.md eq. 2.3): p = 0 on water points whose filling Σ S_I V^w_I/V^full_I
 	// (nodal water-point volume over the node's full in-domain support volume) is below `threshold`;

@@ -542,12 +542,14 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	PressureSystem&   sys    = pressureSystem_;
 	const std::size_t active = sys.node.size();
 	// the surface nodes the menisci can hold: free-surface nodes that carry skeleton, not those beyond a
-	// wall (reached by the round-off tail of the weights only: their rows are all but empty)
+	// wall (reached by the round-off tail of the weights only: their rows are all but empty); and a
+	// drained face's nodes above its table (eq. 8.5g): that face borders air, which gives no water, so it
+	// is a surface of the soil's water as the free one is (held in suction, released where water leaves)
 	std::vector<char> candidate(active, 0);
 	for (std::size_t r = 0; r < active; ++r) {
 		const std::array<int, 3> id   = grid_.indices(sys.node[r]);
 		const Real               full = grid_.inDomainSupportVolume(id[0], id[1], id[2]);
-		candidate[r] = sys.surface[r] && fields_.solid[sys.node[r]].mass > solidMassTolerance_ && full > 0 &&
+		candidate[r] = (sys.surface[r] || sys.aboveFaceTable[r]) && fields_.solid[sys.node[r]].mass > solidMassTolerance_ && full > 0 &&
 		               fields_.water[sys.node[r]].volume >= heldSurfaceFilling * full;
 	}
 	// the active set starts where the last step's ended (a node new to the surface starts held): with K
@@ -808,7 +810,7 @@ template <class Kernel> void TwoPhaseSolver::updateWater(Real dt, bool semiImpli
 		if (!semiImplicit) updatePorePressure(pressureRate_, *w, dt);
 		const long emptied = updateWaterVolume(waterDivergence_, *w, dt);
 		if (emptied >= 0) throwVolumeLost(*w, waterNames_[set], emptied, "the water's divergence emptied it (Δt ∇·v^w ≤ −1)", dt);
-		if (semiImplicit) fillPoresNextToInflowFaces(grid_, domain_.boundaries, water_, *w); // eq. 8.9c
+		if (semiImplicit) fillPoresNextToInflowFaces(grid_, domain_.boundaries, water_, settings_.gravity, *w); // eq. 8.9c
 		// semi-implicit: the points carry the interpolated solution, which holds the faces and the
 		// free surface at their nodes (theory.md §8.5); explicit: relaxations and resets (eqs. 4.17b–c, 2.1, 2.3)
 		if (semiImplicit) continue;
@@ -959,7 +961,10 @@ void TwoPhaseSolver::setInertiaScaleRelease(Real threshold)
 // empty, choked the inflow of a k = 0.05 m/s column to a third of the Darcy flux with the
 // semi-implicit step's flux form, eq. 8.2), and every change of a buffer's mass is counted:
 // growth in injectedWaterMass, shrinking (water pushed back out) in removedWaterMass. Only below
-// the face's water table; rows with no regular water point within 2.5 s are not refilled.
+// the face's water table; rows with no regular water point within 2.5 s are not refilled. Above the
+// table a row is left as it is: a buffer there (the table fell) is the soil's water now, and a regular
+// point cut by outflow (eq. 2.4) is as thin as one — deleted whole, it took a sliver's outflow for a
+// point's.
 void TwoPhaseSolver::injectInflowingWater()
 {
 	const Vec3 lower = grid_.lower(), upper = grid_.upper();
@@ -1078,10 +1083,11 @@ void TwoPhaseSolver::injectInflowingWater()
 					x[axis] = plane + inward * depth;
 					return x;
 				};
-				if (!(gap > 0) || !wall.belowWaterTable(centreAt(0.5 * gap), settings_.gravity)) {
+				if (!(gap > 0)) { // the row has moved out to the face: its buffer's water has left through it
 					if (b >= 0) removeFlags_[b] = 1, anyRemoved = true, removedWaterMass_ += before;
 					continue;
 				}
+				if (!wall.belowWaterTable(centreAt(0.5 * gap), settings_.gravity)) continue;
 				if (gap >= s) { // a full spacing: the buffer (or a new point) becomes a regular one
 					const std::size_t q = b >= 0 ? static_cast<std::size_t>(b) : w->appendCopyOf(outer);
 					w->position[q]      = centreAt(gap - 0.5 * s);

@@ -276,17 +276,21 @@ TEST(CellAverage, SumsEachCellInPointOrderForAnyThreadCount)
 
 namespace {
 
-// theory.md eq. 8.9c: within one cell of an inflow face the reservoir fills the pores, so a water
-// point's volume is the state's, V = m/(n ρw (1 + p/Kw)); a point a cell or more from it, or next to a
-// drained face without inflow, keeps the volume it had (the rate form's).
-TEST(InflowFacePores, PointsWithinACellOfAnInflowFaceTakeTheStateVolume)
+// theory.md eq. 8.9c: within one cell of an inflow face, below its water table, the reservoir fills the
+// pores, so a water point's volume is the state's, V = m/(n ρw (1 + p/Kw)); a point a cell or more from
+// it, next to a drained face without inflow, or above the face's table (air there, not the reservoir:
+// eq. 8.5g holds those nodes in suction with a volume balance of their own) keeps the volume it had (the
+// rate form's).
+TEST(InflowFacePores, PointsWithinACellOfAnInflowFaceBelowItsTableTakeTheStateVolume)
 {
 	using namespace mpm;
 	const GridGeometry grid = GridGeometry::forDomain(Vec3(0, 0, 0), Vec3(0.4, 0.1, 0.3), 0.1);
 	BoundaryConditions bcs;
 	bcs.walls[static_cast<int>(Face::XMin)] = { SolidWall::Slip, WaterWall::Drained, 0.0 };
-	bcs.walls[static_cast<int>(Face::XMin)].inflow = true;
+	bcs.walls[static_cast<int>(Face::XMin)].inflow     = true;
+	bcs.walls[static_cast<int>(Face::XMin)].waterTable = 0.05; // between the lattice's two point layers
 	bcs.walls[static_cast<int>(Face::XMax)] = { SolidWall::Slip, WaterWall::Drained, 0.0 }; // drained, no inflow
+	const Vec3      gravity(0, 0, -9.81);
 	WaterParameters water;
 	const auto      lattice = fixtures::lattice(Vec3(0, 0, 0), Vec3(0.4, 0.1, 0.1), 0.1, 2);
 	WaterPointSet   P       = fixtures::waterLattice(lattice, 0.4, water.density);
@@ -296,17 +300,22 @@ TEST(InflowFacePores, PointsWithinACellOfAnInflowFaceTakeTheStateVolume)
 		P.porePressure[p] = 1e4 * (1 + p % 3);
 	}
 	const WaterPointSet before = P;
-	stages::fillPoresNextToInflowFaces(grid, bcs, water, P);
-	int near = 0;
+	stages::fillPoresNextToInflowFaces(grid, bcs, water, gravity, P);
+	int near = 0, nearAbove = 0;
 	for (std::size_t p = 0; p < P.size(); ++p) {
-		if (P.position[p].x() < grid.cellSize) {
+		const bool nextToFace = P.position[p].x() < grid.cellSize, belowTable = P.position[p].z() < 0.05;
+		if (nextToFace && belowTable) {
 			++near;
 			EXPECT_NEAR(P.volume[p], P.mass[p] / (P.porosity[p] * water.density * (1 + P.porePressure[p] / water.bulkModulus)), 1e-15 * P.volume[p]);
-		} else
-			EXPECT_EQ(P.volume[p], before.volume[p]); // farther in, and next to the drained face without inflow
+		} else {
+			nearAbove += nextToFace;
+			EXPECT_EQ(P.volume[p], before.volume[p]); // above the table, farther in, next to the face without inflow
+		}
 		EXPECT_EQ(P.mass[p], before.mass[p]);
 	}
-	EXPECT_EQ(near, 8); // the lattice's first two point columns (2 × 2 × 2 points per cell)
+	// the lattice's first two point columns (2 × 2 × 2 points per cell): half below the table, half above
+	EXPECT_EQ(near, 4);
+	EXPECT_EQ(nearAbove, 4);
 }
 
 } // namespace
