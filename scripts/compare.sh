@@ -26,7 +26,7 @@ fi
 mpm_run="${MPM_PILE_RUN:-$(mktemp -d)}"
 if [ ! -f "$mpm_run/summary.json" ]; then
   PYTHONPATH="$build/python" yade-double -j2 -n -x "$root/examples/sandpile/sandpile.py" --quick --submerged --crest-lid --lid-friction 0.7 \
-    --scheme semi-implicit --inertia-scale 100 --duration 40 --sand-from-dem "$dem_run" --dem-strength-only --out "$mpm_run"
+    --scheme semi-implicit --inertia-scale 100 --flume-width 0.10 --duration 40 --sand-from-dem "$dem_run" --dem-strength-only --out "$mpm_run"
 fi
 mkdir -p "$pile/mpm-run" "$pile/dem-run"
 cp "$mpm_run/summary.json" "$mpm_run/time_series.csv" "$pile/mpm-run/"

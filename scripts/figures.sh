@@ -5,7 +5,7 @@
 #   compare    scripts/compare.sh: doc/compare/ (MPM against DEM + PFV), doc/tradeoffs.md and
 #              doc/figures/tradeoffs.* (20-40 min; see that script for reusing stored runs)
 #   pile       examples/sandpile/sandpile.py, quick mode (h = 2 cm):
-#              - the main job's scene (yade_mpm.sandpile.DEFAULT, explicit): doc/figures/sandpile_quick_* (3 min)
+#              - the main job's scene (yade_mpm.sandpile.DEFAULT, laboratory history): doc/figures/sandpile_quick_* (9 min)
 #              - the submerged pile on the laboratory head history (yade_mpm.sandpile.SUBMERGED, semi-implicit,
 #                α = 100, crest lid; doc/sandpile.md) in a one-cell-wide flume (plane strain between its smooth
 #                walls; the quick pile moves within 1% of the 0.10 m flume's): h = 2 cm, doc/figures/sandpile_lab_quick_*
@@ -42,6 +42,8 @@ run_pile() {
   for figure in pore_pressure velocity_at_failure shear_band runout time_series; do
     cp "$out/$figure.png" "$figures/sandpile_${name}_$figure.png"
   done
+  # only a pile that failed draws its band at failure
+  [ ! -f "$out/shear_band_at_failure.png" ] || cp "$out/shear_band_at_failure.png" "$figures/sandpile_${name}_shear_band_at_failure.png"
   cp "$out/summary.json" "$figures/sandpile_${name}_summary.json"
 }
 

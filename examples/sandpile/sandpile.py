@@ -3,7 +3,10 @@
 Run:  yade-double -n -x examples/sandpile/sandpile.py [--quick] [--out DIR]
       (or /usr/bin/python3 examples/sandpile/sandpile.py ...)
 
-The scene (flume, pile, sand, water, head history) is yade_mpm.sandpile.DEFAULT, documented there.
+The scene (flume, pile, sand, water, head history) is yade_mpm.sandpile.DEFAULT, documented there: the
+laboratory head history (3 s at 0.03 m, a 60 s rise to 0.12 m, 20 s held) on the semi-implicit step
+with the capillary surface and inertia scaling α = 100 (released by itself should the pile accelerate);
+--scheme explicit runs the 200× compressed history (yade_mpm.sandpile.COMPRESSED).
 3D: the flume's front and rear walls (y = 0, width) are smooth and impermeable (or rough, a Coulomb
 contact, with --side-wall-friction μ), the base is an
 impermeable Coulomb contact (sand glued on it, δ = φ), the upstream face x = 0 is a drained inflow face held at the hydrostatic profile
@@ -12,8 +15,8 @@ that keeps the capillary suction above the phreatic line and is a seepage face (
 none in) below it, and water that seeps out of the pile is taken by the filtering cloth
 (removed once it has left the soil, its mass counted). Mohr–Coulomb sand with friction softening.
 
-Quick mode: cell h = 2 cm (6 cells over the pile height), a few minutes on 2 cores. Full mode:
-h = 1 cm. Both run the whole head history. --sand-from-dem DIR takes the sand from a DEM + PFV pile
+Quick mode: cell h = 2 cm (6 cells over the pile height), 7-9 min on 2 cores. Full mode:
+h = 1 cm (about 16 times the cost). Both run the whole head history. --sand-from-dem DIR takes the sand from a DEM + PFV pile
 run (examples/dem/sandpile.py --out DIR: strength from the drained triaxial test on its grains,
 stiffness, porosity and permeability from the oedometer and flow test on them).
 
@@ -22,7 +25,8 @@ Writes to DIR (default examples/sandpile/out[-quick]):
   pore_pressure.png               pore pressure at four times (x–z view)
   velocity_at_failure.png         solid velocity field at failure (or at the end)
   runout.png                      the pile's surface at up to six frame times (the run-out sequence)
-  shear_band.png                  plastic shear strain with the extracted sliding surface
+  shear_band.png                  plastic shear strain with the extracted sliding surface, at the end
+  shear_band_at_failure.png       the same at failure (the first slide's band), if the pile failed
   time_series.png                 head, pore pressure at probes, slope-face and toe displacement,
                                   solid kinetic energy, water injected, removed and stored,
                                   Bishop's factor of safety on the run's own pore pressures
@@ -57,15 +61,19 @@ from yade import O
 from yade_mpm import MpmHdf5Recorder, MpmSoilMat, MpmTwoPhaseEngine, MpmWaterMat, calibrate, sandpile
 
 parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-parser.add_argument("--quick", action="store_true", help="2 cm cells: a few minutes on 2 cores (the CI test runs this)")
+parser.add_argument("--quick", action="store_true", help="2 cm cells: 7-9 min on 2 cores (the CI test runs this with a 20 s rise)")
 parser.add_argument("--cell", type=float, help="cell size h [m] (default 0.02 quick, 0.01 full)")
 parser.add_argument("--duration", type=float, help="stop after this time [s] (default: the whole head history)")
 parser.add_argument("--out", help="output directory")
-parser.add_argument("--scheme", choices=("explicit", "semi-implicit"), default="explicit",
-                    help="explicit (default: with the suction-holding seepage face and the relaxations of theory.md eqs. 4.17b-c) or "
-                         "semi-implicit (no relaxation; no capillary face yet, so the sand above the water table starts dry)")
-parser.add_argument("--inertia-scale", type=float, default=1.0, help="inertia scaling α ≥ 1 of both phases (theory.md eq. 4.8b), released "
-                                                                     "by itself when the pile accelerates (eq. 4.8c)")
+parser.add_argument("--scheme", choices=("explicit", "semi-implicit"), default="semi-implicit",
+                    help="semi-implicit (default: no relaxation, the capillary surface, the laboratory head history) or explicit "
+                         "(the suction-holding seepage face and the relaxations of theory.md eqs. 4.17b-c; its step follows the water's "
+                         "wave, so it runs the scene's compressed history, yade_mpm.sandpile.COMPRESSED, unless the history's "
+                         "times are given)")
+parser.add_argument("--inertia-scale", type=float, help="inertia scaling α ≥ 1 of both phases (theory.md eq. 4.8b), released "
+                                                        "by itself when the pile accelerates (eq. 4.8c); default 100 on the semi-implicit "
+                                                        "step's laboratory history (the inertia ratio stays ≤ 0.013 there, doc/sandpile.md), "
+                                                        "1 on the explicit step")
 parser.add_argument("--inertia-release", type=float, default=0.1,
                     help="release threshold ε of the inertia scaling (engine inertiaScaleRelease, theory.md eq. 4.8c): the skeleton's "
                          "net inertial force over its weight; a slide of a fraction f of the pile shows as about f × its imbalance. "
@@ -95,13 +103,17 @@ parser.add_argument("--side-wall-friction", type=float, default=0.0, metavar="MU
                     help="Coulomb coefficient μ = tan δ of the flume's front and rear walls (y), a frictional contact (theory.md eq. 2.6); "
                          "0 (default): smooth slip walls, the plane-strain pile")
 parser.add_argument("--flume-width", type=float, metavar="W",
-                    help="distance between the front and rear walls [m], a whole number of cells (default the scene's 0.10 m); with smooth "
-                         "walls the pile is in plane strain, so a one-cell-wide flume gives the same answer at a fraction of the cost "
-                         "(the laboratory history, quick: face and toe within 1%% of the 0.10 m flume's)")
-parser.add_argument("--capillary-surface", action="store_true",
-                    help="semi-implicit only: the sand above the water table starts saturated in suction and its surface holds it as "
-                         "capillary menisci do, a seepage face only where it would hold p > 0 (MpmTwoPhaseEngine.capillarySurface, "
-                         "theory.md eq. 8.5e); without it the semi-implicit pile is dry above the table")
+                    help="distance between the front and rear walls [m], a whole number of cells (default: one cell between smooth "
+                         "walls, the scene's 0.10 m with --side-wall-friction); with smooth walls the pile is in plane strain, so a "
+                         "one-cell-wide flume gives the same answer at a fraction of the cost (the laboratory history, quick: face and "
+                         "toe within 1%% of the 0.10 m flume's)")
+parser.add_argument("--capillary-surface", action=argparse.BooleanOptionalAction, default=None,
+                    help="semi-implicit only (its default there): the sand above the water table starts saturated in suction and its "
+                         "surface holds it as capillary menisci do, a seepage face only where it would hold p > 0 "
+                         "(MpmTwoPhaseEngine.capillarySurface, theory.md eqs. 8.5e-g); with --no-capillary-surface the semi-implicit "
+                         "pile is dry above the table")
+parser.add_argument("--time-step-factor", type=float, metavar="C",
+                    help="the engine's timeStepFactor C, 0 < C ≤ 1: sub-steps of C × its critical step (default the engine's, 0.5)")
 parser.add_argument("--points-per-cell", type=int, default=2, metavar="N", help="points per cell and axis of each phase (default 2)")
 parser.add_argument("--shape-function", choices=("linear", "uGIMP", "cpGIMP"), default="uGIMP", help="the engine's shape functions (default uGIMP)")
 parser.add_argument("--sand-from-dem", metavar="DIR",
@@ -119,7 +131,9 @@ if not args.side_wall_friction >= 0:
 if args.lid_friction > 0 and not args.crest_lid:
     raise SystemExit("--lid-friction %r needs --crest-lid (there is no lid without it)" % args.lid_friction)
 
-SCENE = sandpile.SUBMERGED if args.submerged else sandpile.DEFAULT
+SEMI_IMPLICIT = args.scheme == "semi-implicit"
+# the explicit step follows the water's wave: the laboratory history would take days there
+SCENE = sandpile.SUBMERGED if args.submerged else sandpile.DEFAULT if SEMI_IMPLICIT else sandpile.COMPRESSED
 SUBMERGED = SCENE.still_water_level is not None
 if SUBMERGED and args.scheme != "semi-implicit":
     raise ValueError("--submerged runs on --scheme semi-implicit (got %r)" % args.scheme)
@@ -146,7 +160,10 @@ if args.sand_from_dem is not None:
                    "DEM pile's triaxial, oedometer and flow tests on its grains, ") + dem_summary_path
 elif args.dem_strength_only:
     raise SystemExit("--dem-strength-only needs --sand-from-dem DIR (there is no DEM sand to take the strength from)")
-SEMI_IMPLICIT = args.scheme == "semi-implicit"
+if args.capillary_surface is None:
+    args.capillary_surface = SEMI_IMPLICIT and not SUBMERGED  # under still water the pile has no surface in air
+if args.inertia_scale is None:
+    args.inertia_scale = 100.0 if SEMI_IMPLICIT and not SUBMERGED else 1.0
 if args.capillary_surface and not SEMI_IMPLICIT:
     raise SystemExit("--capillary-surface needs --scheme semi-implicit (the explicit scheme's surface holds suction by freeSurfaceHoldsSuction)")
 # the sand above the table is saturated in suction where a surface holds it (explicit, or semi-implicit with the
@@ -155,13 +172,15 @@ SUCTION_ABOVE_TABLE = not SEMI_IMPLICIT or args.capillary_surface
 GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
 G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]
 CELL = args.cell or (0.02 if args.quick else 0.01)  # h [m]
+if args.flume_width is None and args.side_wall_friction == 0:
+    args.flume_width = CELL  # plane strain between smooth walls: one cell gives the wide flume's answer
 if args.flume_width is not None:
     if not (args.flume_width > 0 and abs(args.flume_width / CELL - round(args.flume_width / CELL)) < 1e-9):
         raise SystemExit("--flume-width %r m must be a positive whole number of cells (h = %g m)" % (args.flume_width, CELL))
     SCENE = dataclasses.replace(SCENE, flume_width=args.flume_width)
 DURATION = args.duration or SCENE.duration()  # [s]
 OUT = args.out or os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "out-quick" if args.quick else "out")
-RECORD_INTERVAL = SCENE.duration() / 70  # time between time-series samples: 0.01 s for the default history [s]
+RECORD_INTERVAL = SCENE.duration() / 70  # time between time-series samples: 1.19 s for the default history [s]
 FIELD_INTERVAL = 5 * RECORD_INTERVAL     # time between HDF5 frames and limit-equilibrium evaluations [s]
 FAILURE_DISPLACEMENT = 0.01 * SCENE.pile_height  # mean displacement of the lower slope face that marks failure [m]
 # plastic shear strain that marks a point as part of the shear band: ten softening scales, where the
@@ -221,8 +240,6 @@ SIDE_WALL = "frictional" if args.side_wall_friction > 0 else "slip"
 engine = MpmTwoPhaseEngine(
     label="mpm", gravity=GRAVITY, domainMin=(0, 0, 0), domainMax=(SCENE.flume_length, SCENE.flume_width, SCENE.domain_height()),
     cellSize=CELL, shapeFunction=args.shape_function,
-    # by default the pile still runs on the explicit scheme with its relaxations (theory.md eqs.
-    # 4.17b-c, 2.3b); porting it to the semi-implicit scheme is the sand-pile issue's work
     scheme=args.scheme, pressureModeDamping=not SEMI_IMPLICIT, inertiaScale=args.inertia_scale,
     inertiaScaleRelease=args.inertia_release,
     stillWaterLevel=SCENE.still_water_level if SUBMERGED else float("-inf"),  # pore pressures are excess ones when submerged
@@ -240,7 +257,8 @@ engine = MpmTwoPhaseEngine(
     freeSurfaceThreshold=0.75,  # the outer point layer is the pile's surface ...
     freeSurfaceHoldsSuction=not SEMI_IMPLICIT,  # ... held by capillarity above the phreatic line, a seepage face below it
     capillarySurface=args.capillary_surface,    # the same on the semi-implicit step (theory.md eq. 8.5e)
-    removeFreeWater=True)       # the filtering cloth
+    removeFreeWater=True,       # the filtering cloth
+    **({} if args.time_step_factor is None else dict(timeStepFactor=args.time_step_factor)))  # the engine refuses C outside (0, 1]
 recorder = MpmHdf5Recorder(label="recorder", file=os.path.join(OUT, "sandpile.h5"), iterPeriod=1)
 O.engines = [engine, recorder, yade_mpm.progress(seconds=60)]  # a progress line with an ETA every minute
 
@@ -288,7 +306,7 @@ def mass_balance():
 
 # --- run -------------------------------------------------------------------------------------------
 # O.dt is the interval at which the head is updated; the engine sub-steps it to its stable step.
-O.dt = RECORD_INTERVAL / 50  # 2e-4 s for the default history
+O.dt = RECORD_INTERVAL / 50  # 0.024 s for the default history
 O.stopAtTime = DURATION  # the end of the head history; also what the progress ETA refers to
 steps_per_record = int(round(RECORD_INTERVAL / O.dt))
 records_per_frame = int(round(FIELD_INTERVAL / RECORD_INTERVAL))
@@ -303,7 +321,7 @@ stopped = None  # the solver's message if the run went unstable: what was record
 wall_start = time.time()
 solver_time = 0.0  # wall time in the steps (HDF5 frames included), without this script's records and checks [s]
 record = 0
-while O.time < DURATION - 1e-12:
+while O.time < DURATION - 0.5 * O.dt:  # O.time sums O.dt: thousands of round-offs, far below a step
     recorder.dead = record % records_per_frame != 0
     try:
         steps_start = time.time()
@@ -360,6 +378,7 @@ while O.time < DURATION - 1e-12:
         failure = dict(row)
         snapshots["failure"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
         failure_state = (solid.pos.copy(), solid.vel.copy())
+        failure_kappa = solid.plasticShearStrain.copy()  # the band of the first slide, before what follows strains the rest
     mid = SCENE.settle_time + 0.5 * SCENE.head_ramp_time
     if "mid rise" not in snapshots and O.time >= mid - 1e-9:
         snapshots["mid rise"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
@@ -375,26 +394,20 @@ if failure is None:
 # --- sliding surface: the base of the shear band --------------------------------------------------
 # (from κ, not from the displacement: at failure the slide has moved millimetres, while the band
 # where the sand has softened to its critical state is already complete)
-moving = solid.plasticShearStrain > BAND_STRAIN
-x0, z0 = start_positions[:, 0], start_positions[:, 2]
-bins = np.arange(0, toe + CELL, spacing)
-surface_x, surface_z = [], []
-for lo in bins:
-    column = (x0 >= lo) & (x0 < lo + spacing)
-    if not (column & moving).any():
-        continue
-    # the sliding surface lies under the lowest band point of the column (undeformed positions)
-    surface_x.append(lo + 0.5 * spacing)
-    surface_z.append(float(z0[column & moving].min()) - 0.5 * spacing)
-surface_x, surface_z = np.array(surface_x), np.array(surface_z)
-sliding = None
-if len(surface_x):
-    depth = SCENE.surface_height(surface_x) - surface_z
-    sliding = {"scarp_x_m": float(surface_x.min()), "exit_x_m": float(surface_x.max()),
-               "lowest_z_m": float(surface_z.min()), "max_depth_below_surface_m": float(depth.max()),
-               "exit_z_m": float(surface_z[np.argmax(surface_x)]),
-               "band_volume_fraction": float(moving.mean()), "band_strain": BAND_STRAIN,
-               "passes_through_toe_region": bool(abs(surface_x.max() - toe) <= 2 * CELL and surface_z[np.argmax(surface_x)] <= 2 * CELL)}
+def band_base(kappa):
+    """The sliding surface under the points past the band's threshold (yade_mpm.analysis.sliding_surface),
+    with the share of the pile they make up and whether it exits at the toe; None if no point is."""
+    moving = kappa > BAND_STRAIN
+    found = yade_mpm.analysis.sliding_surface(start_positions, moving, spacing, SCENE.surface_height, offset=0.5 * spacing)
+    if found is not None:
+        found.update({"band_volume_fraction": float(moving.mean()), "band_strain": BAND_STRAIN,
+                      "passes_through_toe_region": bool(abs(found["exit_x_m"] - toe) <= 2 * CELL and found["exit_z_m"] <= 2 * CELL)})
+    return found
+
+
+sliding = band_base(solid.plasticShearStrain)
+# at failure (the slope face's criterion): the first slide's band, before the run-out strains the rest
+sliding_at_failure = band_base(failure_kappa) if failure is not None else None
 
 # --- limit equilibrium: the head at which Bishop's factor of safety first falls below 1 -----------
 def lem_crossing(which):
@@ -447,6 +460,7 @@ summary = {
     "cell_size_m": CELL,
     "points_per_phase_initial": int(len(positions)),
     "points_per_cell": args.points_per_cell,
+    "time_step_factor": engine.timeStepFactor,
     "shape_function": args.shape_function,
     "capillary_surface": args.capillary_surface,
     "solid_points": int(solid.count),
@@ -475,6 +489,7 @@ summary = {
                                               "face_displacement_m": failure["face_displacement_m"],
                                               "criterion": "mean displacement of the lower slope face > %.4f m" % FAILURE_DISPLACEMENT},
     "sliding_surface": sliding,
+    "sliding_surface_at_failure": sliding_at_failure,
     "limit_equilibrium": lem_summary,
     "onset": onset,
     "kinetic_onset": kinetic,
@@ -521,7 +536,14 @@ if lem_records:  # the critical circle at the LEM onset, or where F was lowest
     critical = (*circle.surface(), "Bishop's critical circle, F = %.2f at t = %.2f s" % (circle.factor, t_c))
 yade_mpm.plotting.plastic_shear_strain(os.path.join(OUT, "shear_band.png"), start_positions, solid.plasticShearStrain, SCENE, x_max,
                                        "plastic shear strain at t = %.2f s on the undeformed pile" % O.time,
-                                       surface=(surface_x, surface_z, "sliding surface (base of the band κ > %.2f)" % BAND_STRAIN), circle=critical)
+                                       surface=None if sliding is None else (sliding["x_m"], sliding["z_m"], "sliding surface (base of the band κ > %.2f)" % BAND_STRAIN),
+                                       circle=critical)
+if failure is not None:
+    yade_mpm.plotting.plastic_shear_strain(os.path.join(OUT, "shear_band_at_failure.png"), start_positions, failure_kappa, SCENE, x_max,
+                                           "plastic shear strain at failure (t = %.2f s) on the undeformed pile" % failure["time_s"],
+                                           surface=None if sliding_at_failure is None else
+                                           (sliding_at_failure["x_m"], sliding_at_failure["z_m"], "sliding surface (base of the band κ > %.2f)" % BAND_STRAIN),
+                                           circle=critical)
 yade_mpm.plotting.runout_sequence(os.path.join(OUT, "runout.png"), profiles + [(O.time, deposit_x, deposit_z)], SCENE, x_max)
 yade_mpm.plotting.time_series(os.path.join(OUT, "time_series.png"), {key: [r[key] for r in rows] for key in rows[0]},
                               lem=([r[0] for r in lem_records],
@@ -529,6 +551,7 @@ yade_mpm.plotting.time_series(os.path.join(OUT, "time_series.png"), {key: [r[key
                                     "the same, slides ≥ %d cells deep" % DEEP_SLIDE_CELLS: [None if r[3] is None else r[3].factor for r in lem_records],
                                     "slides ≥ %d cells deep, peak strength (no Davis)" % DEEP_SLIDE_CELLS: [None if r[4] is None else r[4].factor for r in lem_records]}),
                               failure_displacement=FAILURE_DISPLACEMENT, failure_time=failure["time_s"] if failure else None)
-print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "stopped_unstable", "failure", "sliding_surface", "water_mass_balance", "stable_before_rise")}, indent=2))
+print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "stopped_unstable", "failure", "sliding_surface", "sliding_surface_at_failure", "water_mass_balance",
+                                          "stable_before_rise")}, indent=2))
 print(json.dumps({k: lem_summary[k] for k in ("lem_onset_head_m", "factors", "lem_deep_onset_head_m", "deep_factors", "lem_deep_peak_onset_head_m", "deep_peak_factors")}))
 print(json.dumps({k: summary[k] for k in ("onset", "kinetic_onset", "runout_m", "mobilised_fraction")}))

@@ -1,12 +1,16 @@
-"""The sand-pile example in quick mode, end to end in YADE (examples/sandpile/sandpile.py): it runs
-the whole head history, writes every output, keeps the water mass balance closed, stands still
-while the head is held low and accelerates once it is held high; the pore pressure at the upstream
-probe follows the rising head. That it fails along a surface reaching the base near the toe is
-expected and not met today (xfail, issue 15; the millimetre criterion itself is crossed only at the
-last record)."""
+"""The sand-pile example in quick mode, end to end in YADE (examples/sandpile/sandpile.py) on its
+default path (semi-implicit step, capillary surface, inertia scaling α = 100, laboratory time scale)
+with the head rise shortened for CI (conftest.QUICK_SANDPILE_HISTORY: 20 s instead of 60 s, still
+seconds of real seepage, not the 200× compressed history): it runs the whole history, writes every
+output, keeps the water mass balance closed, stands while the head is low (also by Bishop's method on
+its own pressures), fails once the head has risen with a slip that accelerates and then runs out, its
+first slide a toe slide on a band, and the pressure behind the inflow face follows the head. Not met today (xfail, issue 15): one sliding
+surface (the pile flattens, its band threshold exceeded in most of it) and an onset head within 10% of
+the limit-equilibrium one. The default 60 s history's numbers are in doc/sandpile.md."""
 import csv
 import json
 import math
+import os
 import pathlib
 import subprocess
 
@@ -15,8 +19,8 @@ import pytest
 
 from conftest import start_quick_sandpile
 
-OUTPUTS = ["summary.json", "time_series.csv", "time_series.png", "pore_pressure.png", "velocity_at_failure.png", "shear_band.png", "runout.png",
-           "sandpile.h5", "sandpile.xmf"]
+OUTPUTS = ["summary.json", "time_series.csv", "time_series.png", "pore_pressure.png", "velocity_at_failure.png", "shear_band.png",
+           "shear_band_at_failure.png", "runout.png", "sandpile.h5", "sandpile.xmf"]
 
 
 @pytest.fixture(scope="module")
@@ -59,63 +63,92 @@ def test_pile_stands_while_the_head_is_low(quick_run):
     assert summary["stable_before_rise"]["face_displacement_m"] < 1e-4
 
 
-NO_SLIDE = ("issue 15: the quick explicit pile creeps and accelerates after the rise but forms no sliding surface; "
-            "since the drained-face reset follows a geometric rule (theory.md eq. 2.1) it crosses the 1.2 mm criterion "
-            "only at its last record (1.30 mm at 0.70 s; 0.72 mm at 0.64 s): accelerating creep, not a slide that runs out")
+NO_SLIDE = ("issue 15: the quick pile yields from the toe upwards and flattens (plastic shear strain past the band's threshold in "
+            "88% of it at the end, 86% on the 60 s history); no one band from scarp to exit")
+ONSET_OFF_LEM = ("issue 15: the kinematic onset precedes the limit-equilibrium head (measured on the 20 s rise: compliance onset "
+                 "0.051 m against Bishop's 0.057 m, -11%; on the 60 s history -30%, the kinetic one +3.4%)")
 
 
-def face_rate(rows, t_end, span=0.05):
-    """Mean speed of the lower slope face over (t_end − span, t_end) [m/s]."""
-    near = lambda t: min(rows, key=lambda r: abs(r["time_s"] - t))
-    return (near(t_end)["face_displacement_m"] - near(t_end - span)["face_displacement_m"]) / span
+def test_limit_equilibrium_says_the_pile_stands_at_the_starting_head(quick_run):
+    """Bishop's critical circle (Davis' strength) on the run's own pore pressures at the first
+    evaluation, under the starting head: F > 1 (measured 1.47). It was 0.87 while the inflow face
+    above the reservoir's level fed the capillary fringe (theory.md eq. 8.5g): the pile crept from
+    the start."""
+    _, summary, _ = quick_run
+    lem = summary["limit_equilibrium"]
+    assert lem["times_s"][0] <= summary["scene"]["settle_time"]
+    assert lem["factors"][0] > 1.2
 
 
-def test_slope_face_accelerates_while_the_head_is_held_high(quick_run):
-    """The infinite-slope factor of safety of the 30° seepage face is 0.43–0.63 at the high head: the
-    slope must not arrest. Over the hold the lower face speeds up (measured 1.1e-4 → 7.2e-4 m from
-    0.40 to 0.64 s and 1.30e-3 m at 0.70 s, many times faster at the end than just after the rise)."""
-    _, summary, rows = quick_run
-    scene = summary["scene"]
-    rise_end = scene["settle_time"] + scene["head_ramp_time"]
-    assert face_rate(rows, rows[-1]["time_s"]) > 2 * face_rate(rows, rise_end + 0.05) > 0
-
-
-@pytest.mark.xfail(strict=True, reason=NO_SLIDE)
-def test_pile_fails_after_the_head_has_risen(quick_run):
+def test_pile_fails_once_the_head_has_risen_and_runs_out(quick_run):
+    """Failure (the lower slope face's mean displacement past 1% of the pile height) only in the
+    second half of the rise, above the mid head; the solid's kinetic energy grows a hundredfold from
+    the end of settling to it (an accelerating slip, measured 2e-11 → 1.4e-7 J); by the end the toe
+    has moved more than 10% of the pile height (measured 94 mm of 120 mm) and its front has advanced
+    by more than a cell (0.099 m)."""
     _, summary, rows = quick_run
     scene = summary["scene"]
     failure = summary["failure"]
     assert failure is not None, "no failure: lower slope face moved %.2e m" % rows[-1]["face_displacement_m"]
-    # not while the head is low, nor early in the rise: the seepage has to build up first
     assert failure["time_s"] > scene["settle_time"] + 0.5 * scene["head_ramp_time"]
     assert failure["head_m"] > 0.5 * (scene["head_start"] + scene["head_end"])
-    # a slide, not a creep that arrests: over the last 0.05 s the lower face moves at least as fast
-    # as over the 0.05 s up to the criterion, and far faster than while the head rose (measured
-    # 18.8 against 15.3 and 0.51 mm/s with the 0.35 s hold)
-    rise_end = scene["settle_time"] + scene["head_ramp_time"]
-    assert face_rate(rows, rows[-1]["time_s"]) >= face_rate(rows, failure["time_s"])
-    assert face_rate(rows, rows[-1]["time_s"]) > 10 * face_rate(rows, rise_end)
-    # and it runs out: the millimetre criterion alone is met by creep (1.30 mm at the last record,
-    # 0.70 s); a slide moves the toe by at least a cell by the end (measured 1.2 mm of 20 mm)
-    assert rows[-1]["toe_displacement_m"] >= summary["cell_size_m"]
+    settled = [r for r in rows if r["time_s"] <= scene["settle_time"] + 1e-9][-1]
+    at_failure = min(rows, key=lambda r: abs(r["time_s"] - failure["time_s"]))
+    assert at_failure["kinetic_energy_J"] > 100 * settled["kinetic_energy_J"]
+    assert rows[-1]["toe_displacement_m"] > 0.1 * scene["pile_height"]
+    assert summary["runout_m"] > summary["cell_size_m"]
+
+
+def test_the_slide_runs_out_under_the_held_head(quick_run):
+    """After failure the slide speeds up, peaks and slows down as the slope flattens under the held
+    head: the kinetic energy peaks after the failure record and ends below half its peak (measured
+    peak 2.4e-5 J at 21.9 s, 3.1e-6 J at the end)."""
+    _, summary, rows = quick_run
+    peak = max(rows, key=lambda r: r["kinetic_energy_J"])
+    assert peak["time_s"] > summary["failure"]["time_s"]
+    assert rows[-1]["kinetic_energy_J"] < 0.5 * peak["kinetic_energy_J"]
+
+
+def test_the_first_slide_is_a_toe_slide_on_a_band(quick_run):
+    """At failure (the slope face's criterion) the points past the band's threshold (κ > 10 κ_s, the
+    sand at its critical state) are a band under the lower slope, not the pile: under a tenth of it
+    (measured 7%), over consecutive point columns from a scarp on the slope to an exit at the base
+    within 2 cells of the toe (measured x = 0.23 → 0.30 m, toe 0.308 m, 3.3 cm deep: where Bishop's
+    critical circle lies). What follows is not one slide: see the next test."""
+    _, summary, _ = quick_run
+    surface = summary["sliding_surface_at_failure"]
+    scene, cell = summary["scene"], summary["cell_size_m"]
+    assert surface is not None
+    toe = scene["crest_length"] + scene["pile_height"] / math.tan(scene["slope_angle"])
+    assert surface["band_volume_fraction"] < 0.1, surface
+    columns = np.diff(surface["x_m"])
+    assert np.allclose(columns, columns[0]), surface  # no gap between the band's columns
+    assert surface["exit_z_m"] <= cell and abs(surface["exit_x_m"] - toe) <= 2 * cell, surface
+    assert surface["scarp_x_m"] < surface["exit_x_m"] - 2 * cell, surface
 
 
 @pytest.mark.xfail(strict=True, reason=NO_SLIDE)
-def test_sliding_surface_reaches_the_base_near_the_toe(quick_run):
+def test_one_sliding_surface_reaches_the_base_near_the_toe(quick_run):
     _, summary, _ = quick_run
     surface = summary["sliding_surface"]
     scene = summary["scene"]
     cell = summary["cell_size_m"]
     assert surface is not None
     toe = scene["crest_length"] + scene["pile_height"] / math.tan(scene["slope_angle"])
-    # a deep-seated slip along the base that takes the toe along, not a shallow slip of the slope
-    # face. The example's flag (exit within 2 cells of the toe) holds in full mode (exit 0.3025 m,
-    # toe 0.308 m); at h = 2 cm the band reaches the base 0.043 m = 2.15 cells before the toe by
-    # the end of the run since the edge smoothing (theory.md eq. 4.17c; 0.295 m before it), the
-    # toe wedge in front of it pushed along: so here 3 cells.
+    # a band, not the whole pile: past the threshold in less than half of it (a band 3 cells wide
+    # from the crest to the toe is about that at h = 2 cm; today 0.88)
+    assert surface["band_volume_fraction"] < 0.5, surface
+    # from a scarp behind the slope to an exit at the base within 2 cells of the toe
     assert surface["exit_z_m"] <= cell, surface
-    assert abs(surface["exit_x_m"] - toe) <= 3 * cell, surface
+    assert abs(surface["exit_x_m"] - toe) <= 2 * cell, surface
     assert surface["scarp_x_m"] < surface["exit_x_m"] - 2 * cell, surface
+
+
+@pytest.mark.xfail(strict=False, reason=ONSET_OFF_LEM)
+def test_onset_head_within_ten_percent_of_limit_equilibrium(quick_run):
+    _, summary, _ = quick_run
+    assert summary["onset_head_m"] is not None and summary["lem_onset_head_m"] is not None
+    assert abs(summary["onset_head_m"] - summary["lem_onset_head_m"]) <= 0.1 * summary["lem_onset_head_m"]
 
 
 def test_upstream_pore_pressure_follows_the_rising_head(quick_run):
@@ -127,19 +160,17 @@ def test_upstream_pore_pressure_follows_the_rising_head(quick_run):
     after = [r[key] for r in rows if r["time_s"] <= scene["settle_time"] + scene["head_ramp_time"] + 1e-9][-1]
     g = sum(c * c for c in summary["gravity_m_per_s2"]) ** 0.5
     rise = scene["water_density"] * g * (scene["head_end"] - scene["head_start"])
-    # 5 cm from the inflow face the pressure follows the head (measured 58% of γw ΔH; 100% would be
-    # hydrostatic behind the face). While the crest acted as ponded water it rose by only 39%:
-    # more than half tells the suction-holding surface is doing its job.
+    # 5 cm from the inflow face the pressure follows the head (measured 100% of γw ΔH on the 20 s
+    # rise, hydrostatic behind the face; 58% on the compressed explicit one, 39% while its crest
+    # acted as ponded water): more than half tells the water gets in behind the face.
     assert after - before > 0.5 * rise
 
 
 def test_limit_equilibrium_factor_falls_under_the_raised_head(quick_run):
     """Bishop's critical circle on the run's own pore pressures (yade_mpm.slope_stability, Davis'
-    strength φ* = 31.9°): every evaluation gives a finite, positive F, and holding the head at the
-    crest lowers it below its value at the end of settling — the higher pressures behind the slope
-    reduce its effective stress. (The value itself is below 1 from the start: the seepage face at
-    the toe, where the infinite slope gives (γ′/γsat) tan φ*/tan 30° ≈ 0.5; measured 0.82 after
-    settling, 0.67 at 0.66 s, while the MPM pile only creeps: issue 15.)"""
+    strength φ* = 31.9°): every evaluation gives a finite, positive F, and the raised head lowers it
+    below its value at the end of settling — the higher pressures behind the slope reduce its
+    effective stress (measured 1.47 → 0.2–0.8)."""
     _, summary, _ = quick_run
     lem = summary["limit_equilibrium"]
     scene = summary["scene"]
@@ -180,3 +211,22 @@ def test_summary_reports_onset_runout_and_water_that_really_flowed(quick_run):
         toe = scene["crest_length"] + scene["pile_height"] / math.tan(scene["slope_angle"])
         assert 0 <= zone["x_range_m"][0] <= zone["x_range_m"][1] <= toe and 0 <= zone["z_range_m"][0] <= zone["z_range_m"][1] <= scene["pile_height"]
         assert zone["count"] == round(0.1 * summary["points_per_phase_initial"])
+
+
+def test_explicit_scheme_runs_the_compressed_history_and_stands_while_settling(tmp_path):
+    """--scheme explicit takes yade_mpm.sandpile.COMPRESSED (its step follows the water's wave: the
+    laboratory history would take days), without the capillary surface (its surface holds suction by
+    freeSurfaceHoldsSuction) and at the true inertia; over its 0.05 s settling the pile settles
+    elastically only (γ H²/E ≈ 15 µm; the toe's and the face's mean displacement below 0.1 mm)."""
+    done = subprocess.run(["yade-double", "-j2", "-n", "-x", str(pathlib.Path(__file__).parents[2] / "examples" / "sandpile" / "sandpile.py"),
+                           "--quick", "--scheme", "explicit", "--duration", "0.05", "--out", str(tmp_path)],
+                          capture_output=True, text=True, timeout=300, env=dict(os.environ, HOME=str(tmp_path)),
+                          stdin=subprocess.DEVNULL)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    with open(tmp_path / "summary.json") as f:
+        summary = json.load(f)
+    scene = summary["scene"]
+    assert (scene["settle_time"], scene["head_ramp_time"], scene["hold_time"]) == (0.05, 0.3, 0.35)
+    assert summary["scheme"] == "explicit" and summary["capillary_surface"] is False and summary["inertia_scale"] == 1.0
+    assert abs(summary["stable_before_rise"]["toe_displacement_m"]) < 1e-4
+    assert abs(summary["stable_before_rise"]["face_displacement_m"]) < 1e-4
