@@ -167,16 +167,23 @@ TEST(CapillarySurface, HeldTopDrainsThroughTheBaseLikeTerzaghi)
 // range and 1.5e-9 m/s after 0.3 s, a start off equilibrium, not the face).
 class ReservoirBeside : public ::testing::TestWithParam<bool> {};
 
-TEST_P(ReservoirBeside, FaceAboveItsLevelHoldsTheSuctionBehindIt)
+// Puts column c's xMin face beside a reservoir (drained, its level at the column's table) and makes its
+// water incompressible; the solver is rebuilt by the caller (after moving points, if it does)
+void besideAReservoir(CapillaryColumn& c, bool inflow)
 {
-	const bool      inflow = GetParam();
-	CapillaryColumn c(true, 0, CapillaryColumn::height, 2, 2);
 	WallConditions& side = c.domain.boundaries.walls[static_cast<int>(Face::XMin)];
 	side                 = { SolidWall::Slip, WaterWall::Drained };
 	side.waterTable      = c.table;
 	side.inflow          = inflow;
 	c.water.bulkModulus  = std::numeric_limits<double>::infinity();
-	c.solver             = std::make_unique<TwoPhaseSolver>(c.domain, c.settings);
+}
+
+TEST_P(ReservoirBeside, FaceAboveItsLevelHoldsTheSuctionBehindIt)
+{
+	const bool      inflow = GetParam();
+	CapillaryColumn c(true, 0, CapillaryColumn::height, 2, 2);
+	besideAReservoir(c, inflow);
+	c.solver = std::make_unique<TwoPhaseSolver>(c.domain, c.settings);
 	c.solver->setPoints({ SolidSet { &c.solid, c.soil, false, SkeletonModel::LinearElastic, StrengthParameters {} } }, { &c.fluid }, c.water);
 	double waterMass = 0;
 	for (std::size_t p = 0; p < c.fluid.size(); ++p) waterMass += c.fluid.mass[p];
@@ -212,11 +219,7 @@ INSTANTIATE_TEST_SUITE_P(CapillarySurface, ReservoirBeside, ::testing::Bool());
 TEST(CapillarySurface, APointCutAtAnInflowFaceAboveItsTableLosesOnlyTheCut)
 {
 	CapillaryColumn c(true, 0, CapillaryColumn::height, 2, 2);
-	WallConditions& side = c.domain.boundaries.walls[static_cast<int>(Face::XMin)];
-	side                 = { SolidWall::Slip, WaterWall::Drained };
-	side.waterTable      = c.table;
-	side.inflow          = true;
-	c.water.bulkModulus  = std::numeric_limits<double>::infinity();
+	besideAReservoir(c, true);
 	const double spacing = 0.5 * c.cell, sliver = 1e-3 * spacing; // [m]
 	double       cut     = 0;                                     // [kg] the outer layer's water beyond the face
 	std::size_t  outer   = 0;
