@@ -77,22 +77,13 @@ struct BoundaryConditions {
 	Real stillWaterLevel = -std::numeric_limits<Real>::infinity();
 	bool submerged() const { return std::isfinite(stillWaterLevel); }
 
-	// Whether x lies less than one cell inside a face with waterInflow (theory.md eqs. 4.11d, 8.9c).
-	bool withinACellOfInflowFace(const GridGeometry& grid, const Vec3& x) const
+	// Whether x lies less than one cell inside a face with waterInflow (theory.md eqs. 4.11d, 8.9c); with
+	// `gravity`, only below that face's water table: where the reservoir fills the pores (eq. 8.9c; above
+	// its level the face meets air, eq. 8.5g).
+	bool withinACellOfInflowFace(const GridGeometry& grid, const Vec3& x, const Vec3* gravity = nullptr) const
 	{
 		for (int f = 0; f < faceCount; ++f) {
-			if (!walls[f].inflow) continue;
-			const int d = f / 2;
-			if ((f % 2 ? grid.upper()[d] - x[d] : x[d] - grid.lower()[d]) < grid.cellSize) return true;
-		}
-		return false;
-	}
-	// Whether x lies less than one cell inside a face with waterInflow and below that face's water table:
-	// where the reservoir fills the pores (theory.md eq. 8.9c); above its level the face meets air.
-	bool fedByInflowFace(const GridGeometry& grid, const Vec3& x, const Vec3& gravity) const
-	{
-		for (int f = 0; f < faceCount; ++f) {
-			if (!walls[f].inflow || !walls[f].belowWaterTable(x, gravity)) continue;
+			if (!walls[f].inflow || (gravity && !walls[f].belowWaterTable(x, *gravity))) continue;
 			const int d = f / 2;
 			if ((f % 2 ? grid.upper()[d] - x[d] : x[d] - grid.lower()[d]) < grid.cellSize) return true;
 		}

@@ -249,7 +249,7 @@ namespace stages {
 		const std::size_t count = P.size();
 #pragma omp parallel for schedule(static) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p)
-			if (bcs.fedByInflowFace(grid, P.position[p], gravity)) P.volume[p] = P.mass[p] / (P.porosity[p] * water.density * (1 + P.porePressure[p] * invKw));
+			if (bcs.withinACellOfInflowFace(grid, P.position[p], &gravity)) P.volume[p] = P.mass[p] / (P.porosity[p] * water.density * (1 + P.porePressure[p] * invKw));
 	}
 
 	void applyFreeSurface(const GridGeometry& grid, const GridFields& fields, Real threshold, bool keepSuction, WaterPointSet& P,

@@ -17,9 +17,9 @@ the values below are documented lab-scale choices, not the paper's:
 * the pile starts saturated throughout, at rest: hydrostatic below the inflow level 0.03 m and held
   by capillary suction above it (the experiment keeps the pile saturated for the same reason);
 * head at the inflow face held at 0.03 m for 3 s (the pile settles under gravity), then raised
-  linearly to the crest, 0.12 m, over 60 s (1.5 mm/s, the laboratory rate of seepage-failure
-  flumes: the head is raised by hand or by an overflow weir over about a minute; issue 15 suggests
-  0.03 → 0.12 m over 60 s), then held for 20 s. Over 60 s the water moves: the pile takes in some
+  linearly to the crest, 0.12 m, over 60 s (1.5 mm/s: the laboratory rate issue 15 names,
+  0.03 → 0.12 m over 60 s; the source paper's own rate is not in the text available to us), then
+  held for 20 s. Over 60 s the water moves: the pile takes in some
   40 g of water through the inflow face (doc/sandpile.md), which a compressed rise does not give.
   `COMPRESSED` keeps the same rise over 0.3 s (0.05 s settling, 0.35 s hold) for the explicit step,
   whose time step follows the water's wave (the laboratory history would take ≈ 100 h there at

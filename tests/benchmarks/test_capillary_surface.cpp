@@ -199,14 +199,18 @@ TEST_P(ReservoirBeside, FaceAboveItsLevelHoldsTheSuctionBehindIt)
 	std::printf("column beside a reservoir at its table (inflow %d), after 0.3 s: max |p − p_h| %.2e of the suction range, max speed %.2e m/s, "
 	            "water in %.3e kg, out %.3e kg of %.3f kg\n",
 	            inflow, error, speed, c.solver->injectedWaterMass(), c.solver->removedWaterMass(), waterMass);
-	// an equilibrium of the discrete system up to the solve's tolerance: the same column with that face
-	// impermeable stands within 2.9e-8 of the range at 5e-11 m/s (measured; 3.8e-8 and 3e-10 m/s with the
-	// reservoir). The water that crosses is the round-off drift of the face's points (2e-11 of the
-	// column's water, tiny buffers grown and shrunk, eq. 2.5); the balance closes exactly
-	EXPECT_LT(error, 1e-6);
-	EXPECT_LT(speed, 1e-8);
-	EXPECT_LT(c.solver->injectedWaterMass(), 1e-9 * waterMass);
-	EXPECT_LT(c.solver->removedWaterMass(), 1e-9 * waterMass);
+	// an equilibrium of the discrete system up to the solve's tolerance δp: pressures within δp, speeds
+	// within the Darcy speed of an error δp across a cell, k δp/(γw h) (2.0e-9 m/s), and through the face
+	// at most that speed's water over its area and the 0.3 s, n ρw v A t (6e-9 kg). Measured: 9.3e-5 Pa
+	// (3.8e-8 of the range), 3e-10 m/s, 1.7e-11 kg in (tiny buffers grown and shrunk, eq. 2.5) — as the same
+	// column with that face impermeable (7.2e-5 Pa, 5e-11 m/s); the balance closes exactly
+	const double tolerance = c.settings.pressureTolerance;                                             // δp [Pa]
+	const double darcy     = CapillaryColumn::conductivity * tolerance / (c.gammaWater() * c.cell);     // [m s⁻¹]
+	const double through   = c.soil.porosity * c.water.density * darcy * c.cell * c.height * 0.3;     // [kg]
+	EXPECT_LT(error * range, tolerance);
+	EXPECT_LT(speed, darcy);
+	EXPECT_LT(c.solver->injectedWaterMass(), through);
+	EXPECT_LT(c.solver->removedWaterMass(), through);
 	EXPECT_NEAR(waterMass + c.solver->injectedWaterMass(), stored + c.solver->removedWaterMass(), 1e-12 * waterMass);
 }
 INSTANTIATE_TEST_SUITE_P(CapillarySurface, ReservoirBeside, ::testing::Bool());
@@ -232,15 +236,28 @@ TEST(CapillarySurface, APointCutAtAnInflowFaceAboveItsTableLosesOnlyTheCut)
 	c.solver = std::make_unique<TwoPhaseSolver>(c.domain, c.settings);
 	c.solver->setPoints({ SolidSet { &c.solid, c.soil, false, SkeletonModel::LinearElastic, StrengthParameters {} } }, { &c.fluid }, c.water);
 	const std::size_t points = c.fluid.size();
-	c.solver->step(0.5 * c.solver->timeStepLimits().critical);
-	std::size_t left = 0;
-	for (std::size_t p = 0; p < c.fluid.size(); ++p) left += c.fluid.position[p].x() < spacing && c.fluid.position[p].z() > c.table;
-	std::printf("%zu points cut by %.1e m above the table: removed %.4e kg against %.4e kg beyond the face; %zu of them left\n", outer, sliver,
-	            c.solver->removedWaterMass(), cut, left);
+	const double      dt     = 0.5 * c.solver->timeStepLimits().critical;
+	c.solver->step(dt);
+	std::size_t left  = 0;
+	double      moved = 0; // [kg] what the step's motion of the cut points adds to or takes from the sliver, Σ m |v_x| Δt/s
+	for (std::size_t p = 0; p < c.fluid.size(); ++p)
+		if (c.fluid.position[p].x() < spacing && c.fluid.position[p].z() > c.table) {
+			++left;
+			moved += c.fluid.mass[p] * std::abs(c.fluid.velocity[p].x()) * dt / spacing;
+		}
+	std::printf("%zu points cut by %.1e m above the table: removed %.4e kg against %.4e kg beyond the face (the step's motion: ±%.1e kg); %zu of "
+	            "them left\n",
+	            outer, sliver, c.solver->removedWaterMass(), cut, moved, left);
 	EXPECT_EQ(outer, 20u); // 10 layers × 2 rows above the table
 	EXPECT_EQ(left, outer);
 	EXPECT_GE(c.fluid.size(), points);
-	EXPECT_NEAR(c.solver->removedWaterMass(), cut, 1e-3 * cut); // the points moved by ~1e-13 m in the step
+	// the sliver beyond the face, up to the points' own motion in the step: the shift disturbs the filling
+	// (|v_x| ≤ 2e-5 m/s), Σ m |v_x| Δt/s = 1.4e-8 kg, 1.1e-4 of the sliver's 1.25e-4 kg (measured −1.37e-8 kg).
+	// A tenth of a percent of the sliver holds that motion five times over (checked in the run); a whole
+	// point (the old rule's 0.125 kg) misses it a thousand-fold
+	const double tolerance = 1e-3 * cut; // [kg]
+	ASSERT_LT(5 * moved, tolerance);
+	EXPECT_NEAR(c.solver->removedWaterMass(), cut, tolerance);
 }
 
 // A 30° slope in suction above a low table, wet by a film of water half a cell thick over its surface

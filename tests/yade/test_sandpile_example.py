@@ -71,19 +71,20 @@ ONSET_OFF_LEM = ("issue 15: the kinematic onset precedes the limit-equilibrium h
 
 def test_limit_equilibrium_says_the_pile_stands_at_the_starting_head(quick_run):
     """Bishop's critical circle (Davis' strength) on the run's own pore pressures at the first
-    evaluation, under the starting head: F > 1 (measured 1.47). It was 0.87 while the inflow face
+    evaluation, under the starting head: F > 1, the slope stands (measured 1.47). It was 0.87 while the inflow face
     above the reservoir's level fed the capillary fringe (theory.md eq. 8.5g): the pile crept from
     the start."""
     _, summary, _ = quick_run
     lem = summary["limit_equilibrium"]
     assert lem["times_s"][0] <= summary["scene"]["settle_time"]
-    assert lem["factors"][0] > 1.2
+    assert lem["factors"][0] > 1
 
 
 def test_pile_fails_once_the_head_has_risen_and_runs_out(quick_run):
     """Failure (the lower slope face's mean displacement past 1% of the pile height) only in the
     second half of the rise, above the mid head; the solid's kinetic energy grows a hundredfold from
-    the end of settling to it (an accelerating slip, measured 2e-11 → 1.4e-7 J); by the end the toe
+    the end of settling to it (an accelerating slip, measured 2e-11 → 1.4e-7 J; while the pile settles
+    it varies by less than a factor 2 between records); by the end the toe
     has moved more than 10% of the pile height (measured 94 mm of 120 mm) and its front has advanced
     by more than a cell (0.099 m)."""
     _, summary, rows = quick_run
@@ -111,10 +112,14 @@ def test_the_slide_runs_out_under_the_held_head(quick_run):
 
 def test_the_first_slide_is_a_toe_slide_on_a_band(quick_run):
     """At failure (the slope face's criterion) the points past the band's threshold (κ > 10 κ_s, the
-    sand at its critical state) are a band under the lower slope, not the pile: under a tenth of it
-    (measured 7%), over consecutive point columns from a scarp on the slope to an exit at the base
+    sand at its critical state) are a small part of the pile under the lower slope, under a tenth of
+    it (measured 7%; 86-88% at the end), over consecutive point columns from a scarp on the slope to an
+    exit at the base
     within 2 cells of the toe (measured x = 0.23 → 0.30 m, toe 0.308 m, 3.3 cm deep: where Bishop's
-    critical circle lies). What follows is not one slide: see the next test."""
+    critical circle lies). What follows is not one slide: see the next test. Not the issue's width
+    criterion (a band at most 3 cells wide): the quick pile is 6 cells tall, and a 3-cell band along
+    the end state's surface would cover 93-98% of it, so the width cannot tell a band from a flattening
+    at h = 2 cm; the share of the pile can."""
     _, summary, _ = quick_run
     surface = summary["sliding_surface_at_failure"]
     scene, cell = summary["scene"], summary["cell_size_m"]
@@ -135,9 +140,9 @@ def test_one_sliding_surface_reaches_the_base_near_the_toe(quick_run):
     cell = summary["cell_size_m"]
     assert surface is not None
     toe = scene["crest_length"] + scene["pile_height"] / math.tan(scene["slope_angle"])
-    # a band, not the whole pile: past the threshold in less than half of it (a band 3 cells wide
-    # from the crest to the toe is about that at h = 2 cm; today 0.88)
-    assert surface["band_volume_fraction"] < 0.5, surface
+    # a slide of part of the pile, not the whole pile flattening: the strained share as at failure's
+    # test bound (today 0.88; the width criterion cannot tell them apart at h = 2 cm, see above)
+    assert surface["band_volume_fraction"] < 0.1, surface
     # from a scarp behind the slope to an exit at the base within 2 cells of the toe
     assert surface["exit_z_m"] <= cell, surface
     assert abs(surface["exit_x_m"] - toe) <= 2 * cell, surface
