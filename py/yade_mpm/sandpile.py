@@ -179,7 +179,8 @@ def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing, mi
     (yade_mpm.slope_stability): weights from both phases' point masses, pore pressures from the
     water points, averaged over the flume's width; the sand's peak strength reduced for its
     non-associated flow by Davis (φ = 36°, ψ = 6° → φ* = 31.9°), or with davis=False the peak itself
-    (the upper bound the model's skeleton can mobilise before it softens); slip circles no deeper than the
+    (the upper bound the model's skeleton can mobilise before it softens); centres over the slope from one
+    cell to four pile heights above the base (the toe's slumps as well as deep slides); slip circles no deeper than the
     flume base and at least min_depth deep [m] (default one cell: a thinner slide is below what the
     MPM resolves); with a crest lid, only slides that break through the ground downstream of it (the
     lid's reaction, which holds the crest down against the excess pressure, is not known to the
@@ -198,7 +199,10 @@ def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing, mi
                                                   scene.flume_width, cell_size, strength, direction=1, base_z=0.0,
                                                   surface_offset=0.5 * point_spacing)
     height, toe = scene.pile_height, scene.toe_x()
-    return slope_stability.critical_circle(section, np.linspace(scene.crest_length, toe + 0.5 * height, 9),
-                                           np.linspace(1.1 * height, 4 * height, 9), radii_per_centre=10,
+    # centres from one cell above the base (the small circles of a slump at the toe, where the seepage
+    # leaves the face: 1-2 cells deep, centres a few cm up) to 4 pile heights (the deep circles), spaced
+    # geometrically so that both are searched at the same relative resolution
+    return slope_stability.critical_circle(section, np.linspace(scene.crest_length, toe + 0.5 * height, 13),
+                                           np.geomspace(cell_size, 4 * height, 12), radii_per_centre=10,
                                            min_depth=cell_size if min_depth is None else min_depth, slice_count=30,
                                            free_ground=(scene.crest_length, math.inf) if scene.crest_lid else None)

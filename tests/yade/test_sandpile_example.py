@@ -4,9 +4,10 @@ with the head rise shortened for CI (conftest.QUICK_SANDPILE_HISTORY: 20 s inste
 seconds of real seepage, not the 200× compressed history): it runs the whole history, writes every
 output, keeps the water mass balance closed, stands while the head is low (also by Bishop's method on
 its own pressures), fails once the head has risen with a slip that accelerates and then runs out, its
-first slide a toe slide on a band, and the pressure behind the inflow face follows the head. Not met today (xfail, issue 15): one sliding
-surface (the pile flattens, its band threshold exceeded in most of it) and an onset head within 10% of
-the limit-equilibrium one. The default 60 s history's numbers are in doc/sandpile.md."""
+first slide a toe slide on a band, its onset head within 10% of the limit-equilibrium one, and the pressure
+behind the inflow face follows the head. Not met today (xfail, issue 15): one sliding surface to the end
+(the pile flattens, its band threshold exceeded in most of it). The default 60 s history's numbers are in
+doc/sandpile.md."""
 import csv
 import json
 import math
@@ -65,15 +66,13 @@ def test_pile_stands_while_the_head_is_low(quick_run):
 
 NO_SLIDE = ("issue 15: the quick pile yields from the toe upwards and flattens (plastic shear strain past the band's threshold in "
             "88% of it at the end, 86% on the 60 s history); no one band from scarp to exit")
-ONSET_OFF_LEM = ("issue 15: the kinematic onset precedes the limit-equilibrium head (measured on the 20 s rise: compliance onset "
-                 "0.051 m against Bishop's 0.057 m, -11%; on the 60 s history -30%, the kinetic one +3.4%)")
 
 
 def test_limit_equilibrium_says_the_pile_stands_at_the_starting_head(quick_run):
     """Bishop's critical circle (Davis' strength) on the run's own pore pressures at the first
-    evaluation, under the starting head: F > 1, the slope stands (measured 1.47). It was 0.87 while the inflow face
-    above the reservoir's level fed the capillary fringe (theory.md eq. 8.5g): the pile crept from
-    the start."""
+    evaluation, under the starting head: F > 1, the slope stands (measured 1.21, on a slump at the toe, x = 0.24 →
+    0.31 m, where the seepage leaves the face). It was 0.87 while the inflow face above the reservoir's level fed
+    the capillary fringe (theory.md eq. 8.5g): the pile crept from the start."""
     _, summary, _ = quick_run
     lem = summary["limit_equilibrium"]
     assert lem["times_s"][0] <= summary["scene"]["settle_time"]
@@ -149,8 +148,13 @@ def test_one_sliding_surface_reaches_the_base_near_the_toe(quick_run):
     assert surface["scarp_x_m"] < surface["exit_x_m"] - 2 * cell, surface
 
 
-@pytest.mark.xfail(strict=False, reason=ONSET_OFF_LEM)
 def test_onset_head_within_ten_percent_of_limit_equilibrium(quick_run):
+    """The onset (the slope face's compliance, a kinematic criterion without a millimetre threshold)
+    within 10% of the head at which Bishop's factor on the run's own pressure field crosses 1 (issue 15):
+    measured +9.0% on this 20 s rise (0.0507 against 0.0465 m; Bishop is evaluated every 2 s, 9 mm of
+    head, and interpolated) and −2.6% on the default 60 s history (0.0415 against 0.0426 m). The kinetic
+    onset, the slide's acceleration, is not held to it (−10% here, +43% on the 60 s history: the slump at
+    the toe accelerates only once it has spread up the slope)."""
     _, summary, _ = quick_run
     assert summary["onset_head_m"] is not None and summary["lem_onset_head_m"] is not None
     assert abs(summary["onset_head_m"] - summary["lem_onset_head_m"]) <= 0.1 * summary["lem_onset_head_m"]
@@ -175,7 +179,7 @@ def test_limit_equilibrium_factor_falls_under_the_raised_head(quick_run):
     """Bishop's critical circle on the run's own pore pressures (yade_mpm.slope_stability, Davis'
     strength φ* = 31.9°): every evaluation gives a finite, positive F, and the raised head lowers it
     below its value at the end of settling — the higher pressures behind the slope reduce its
-    effective stress (measured 1.47 → 0.2–0.8)."""
+    effective stress (measured 1.21 → 0.26–0.87)."""
     _, summary, _ = quick_run
     lem = summary["limit_equilibrium"]
     scene = summary["scene"]

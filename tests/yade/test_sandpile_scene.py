@@ -115,3 +115,27 @@ def test_starting_water_table_is_dupuits_steady_surface_below_the_ground():
     assert np.any(h0 > s.surface_height(x[x < L]))
     sub = sandpile.SUBMERGED
     assert np.all(sub.starting_water_table(x) == sub.still_water_level)
+
+
+def test_limit_equilibrium_finds_a_slump_at_the_toe():
+    """A seepage face makes its toe the weakest place: where the water leaves the slope the effective
+    stress is least, and the critical circle is a slump a cell or two deep there (the full pile at its
+    starting head, h = 1 cm: F = 0.85 on such a circle, 1.51 on the best circle centred above 1.1 H).
+    Here the toe's last three cells carry a pore pressure equal to the overburden (σ′ = 0: no strength
+    there) and the rest is dry: a circle through the toe alone loses nearly all its resistance, while a
+    deep one through the dry pile keeps Davis' tan φ*/tan β ≈ 1.08. The search must find the slump (it
+    does: F = 0.002; with centres from 1.1 H up, as before, the best was 0.75 on a circle reaching into the dry pile)."""
+    from types import SimpleNamespace
+    cell = 0.01
+    s = sandpile.DEFAULT
+    points, spacing = sandpile.pile_points(s, cell)
+    volume = spacing ** 3
+    solid = SimpleNamespace(pos=points, mass=np.full(len(points), (1 - s.porosity) * s.grain_density * volume))
+    toe = points[:, 0] > s.toe_x() - 3 * cell
+    saturated_weight = ((1 - s.porosity) * s.grain_density + s.porosity * s.water_density) * 9.81  # [N/m³]
+    water = SimpleNamespace(pos=points[toe], mass=np.full(toe.sum(), s.porosity * s.water_density * volume),
+                            porePressure=saturated_weight * (s.surface_height(points[toe, 0]) - points[toe, 2]))
+    circle = sandpile.limit_equilibrium(s, solid, water, (0.0, 0.0, -9.81), cell, spacing)
+    where = circle.describe()
+    assert circle.factor < 0.5, where
+    assert where["from_x_m"] > s.toe_x() - 5 * cell and where["lowest_z_m"] < 2 * cell, where
