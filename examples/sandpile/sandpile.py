@@ -78,9 +78,9 @@ parser.add_argument("--inertia-release", type=float, default=0.1,
                     help="release threshold ε of the inertia scaling (engine inertiaScaleRelease, theory.md eq. 4.8c): the skeleton's "
                          "net inertial force over its weight; a slide of a fraction f of the pile shows as about f × its imbalance. "
                          "Armed at the end of the settling time (the settling from the starting stresses is no slide)")
-parser.add_argument("--ramp-time", type=float, help="duration of the head rise [s] (default the scene's 0.3 s)")
-parser.add_argument("--settle-time", type=float, help="time at the starting head before the rise [s] (default the scene's 0.05 s)")
-parser.add_argument("--hold-time", type=float, help="head held at the crest after the rise [s] (default the scene's 0.35 s)")
+parser.add_argument("--ramp-time", type=float, help="duration of the head rise [s] (default the scene's: 60 s, yade_mpm.sandpile.DEFAULT; 0.3 s with --scheme explicit)")
+parser.add_argument("--settle-time", type=float, help="time at the starting head before the rise [s] (default the scene's: 3 s; 0.05 s with --scheme explicit)")
+parser.add_argument("--hold-time", type=float, help="head held at the crest after the rise [s] (default the scene's: 20 s; 0.35 s with --scheme explicit)")
 parser.add_argument("--submerged", action="store_true",
                     help="the pile under still water (yade_mpm.sandpile.SUBMERGED: excess pore pressure, theory.md eq. 1.9; "
                          "semi-implicit, the head rising over a laboratory minute)")
@@ -452,6 +452,7 @@ if onset_index is not None and settled is not None:
     first_zone = yade_mpm.analysis.mobilised_zone(rise_start_positions, record_positions[onset_index])
 runout = yade_mpm.analysis.toe_runout(start_positions, solid.pos, toe_x=float(start_positions[:, 0].max()), base_band=2 * CELL)
 deposit_x, deposit_z = yade_mpm.analysis.deposit_profile(solid.pos, PROFILE_BINS, half_height=0.5 * spacing)
+deposit_slope = yade_mpm.analysis.deposit_slope_angle(deposit_x, deposit_z, from_x=SCENE.crest_length, min_height=spacing)
 mobilised, mobilised_fraction = yade_mpm.analysis.mobilised_volume(start_positions, solid.pos, solid.volume, displacement=spacing)
 
 stored, residual = mass_balance()
@@ -502,6 +503,8 @@ summary = {
     "mobilised_volume_m3": mobilised,
     "mobilised_fraction": mobilised_fraction,
     "deposit_profile": {"x_m": deposit_x.tolist(), "z_m": [None if np.isnan(z) else float(z) for z in deposit_z]},
+    # the deposit's mean slope downstream of the crest's edge, its front (thinner than a point) left out
+    "deposit_slope_deg": None if deposit_slope is None else math.degrees(deposit_slope),
     "injected_kg": engine.injectedWaterMass,
     "removed_kg": engine.removedWaterMass,
     "relative_residual": residual,

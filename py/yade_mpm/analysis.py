@@ -84,6 +84,19 @@ def deposit_profile(positions, bin_edges, half_height=0.0):
     return 0.5 * (edges[:-1] + edges[1:]), heights
 
 
+def deposit_slope_angle(x, heights, from_x, min_height):
+    """Mean inclination [rad] of a deposit's surface descending towards +x: the least-squares line
+    through the profile (x, heights) [m] (e.g. deposit_profile's) over the bins at x ≥ from_x whose
+    height exceeds min_height (the thin front, one or two points thick, is not a slope). None if fewer
+    than 3 bins qualify."""
+    x, z = np.asarray(x, dtype=float), np.asarray(heights, dtype=float)
+    use = (x >= from_x) & np.isfinite(z) & (z > min_height)
+    if use.sum() < 3:
+        return None
+    slope = np.polyfit(x[use], z[use], 1)[0]
+    return float(np.arctan(-slope))
+
+
 def mobilised_volume(start_positions, positions, volumes, displacement):
     """Volume [m³] (and its share of the total) of the points that moved more than `displacement`
     [m] since the start — e.g. one point spacing, below which a point has not left its place.

@@ -119,3 +119,15 @@ def test_sliding_surface_is_the_base_of_the_moving_mass_in_its_start_positions()
     above_base = ground(np.array(surface["x_m"])) > 0.02 + spacing  # near the toe the moving mass reaches the base
     assert above_base.sum() > 20 and np.all(np.abs(depth[above_base] - 0.02) <= spacing)
     assert analysis.sliding_surface(start, np.zeros(len(start), bool), spacing, ground) is None
+
+
+def test_deposit_slope_angle_is_the_mean_inclination_of_the_surface():
+    """A deposit 0.1 m high, flat to x = 0.1 m, then descending at 14° to its front, with a thin tail
+    (one point thick) beyond: the fit over the bins past the crest's edge and thicker than the tail
+    returns the 14°, whatever the bins' heights are offset by; too few bins give None."""
+    x = np.arange(0.01, 0.6, 0.02)
+    z = np.where(x < 0.1, 0.1, 0.1 - (x - 0.1) * math.tan(math.radians(14)))
+    z = np.where(z > 0.004, z, np.where(x < 0.55, 0.003, np.nan))  # the tail, then empty bins
+    angle = analysis.deposit_slope_angle(x, z + 0.005, from_x=0.1, min_height=0.01)
+    assert math.degrees(angle) == pytest.approx(14, abs=1e-9)
+    assert analysis.deposit_slope_angle(x[:6], z[:6], from_x=0.1, min_height=0.01) is None

@@ -64,8 +64,9 @@ def test_pile_stands_while_the_head_is_low(quick_run):
     assert summary["stable_before_rise"]["face_displacement_m"] < 1e-4
 
 
-NO_SLIDE = ("issue 15: the quick pile yields from the toe upwards and flattens (plastic shear strain past the band's threshold in "
-            "88% of it at the end, 86% on the 60 s history); no one band from scarp to exit")
+NO_SLIDE = ("issue 15: after its first slide on a band the quick pile yields from the toe upwards and flattens (plastic shear strain "
+            "past the band's threshold in 87% of it at the end, 86% on the 60 s history), as the held head's seepage requires "
+            "(the next test); no one band from scarp to exit at the end")
 
 
 def test_limit_equilibrium_says_the_pile_stands_at_the_starting_head(quick_run):
@@ -129,6 +130,29 @@ def test_the_first_slide_is_a_toe_slide_on_a_band(quick_run):
     assert np.allclose(columns, columns[0]), surface  # no gap between the band's columns
     assert surface["exit_z_m"] <= cell and abs(surface["exit_x_m"] - toe) <= 2 * cell, surface
     assert surface["scarp_x_m"] < surface["exit_x_m"] - 2 * cell, surface
+
+
+def test_the_pile_flattens_to_the_slope_its_residual_strength_holds_under_seepage(quick_run):
+    """Why the pile ends flattened: with the head held at the crest the water table reaches the slope's
+    surface and seeps out along it, and an infinite cohesionless slope with slope-parallel seepage stands
+    only up to tan β = (γ′/γsat) tan φ (e.g. Lambe & Whitman 1969, ch. 24; Skempton & DeLory 1957). At
+    the residual strength the sheared sand is left with, that is 16.0° for φ_r = 30° and 14.0° for
+    Davis' strength at the critical state (ψ = 0: tan φ* = sin φ_r), far below the 30° slope: the pile must
+    keep deforming until its slope is there. The deposit's mean slope at the end lies in that range,
+    widened by the profile's resolution (one point spacing of height over the slope's length). Measured
+    16.0° here, 13.6° on the 60 s history with its 20 s hold."""
+    _, summary, _ = quick_run
+    scene = summary["scene"]
+    saturated = (1 - scene["porosity"]) * scene["grain_density"] + scene["porosity"] * scene["water_density"]
+    ratio = (saturated - scene["water_density"]) / saturated  # γ′/γsat
+    phi_r = scene["residual_friction_angle"]
+    steepest = math.atan(ratio * math.tan(phi_r))
+    flattest = math.atan(ratio * math.sin(phi_r))
+    spacing = summary["cell_size_m"] / summary["points_per_cell"]
+    slope_length = scene["pile_height"] / math.tan(flattest)  # the deposit's horizontal extent, about
+    resolution = math.atan(spacing / slope_length)
+    assert summary["deposit_slope_deg"] is not None
+    assert math.degrees(flattest - resolution) <= summary["deposit_slope_deg"] <= math.degrees(steepest + resolution), summary["deposit_slope_deg"]
 
 
 @pytest.mark.xfail(strict=True, reason=NO_SLIDE)
