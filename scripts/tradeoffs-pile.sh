@@ -1,49 +1,55 @@
 #!/usr/bin/env bash
-# Speed for accuracy of the sand pile (issue 15; not a test): the submerged, lidded pile on the laboratory
-# head history (yade_mpm.sandpile.SUBMERGED: 1 s at the still level, the head raised 0.12 m over 60 s, held
-# 20 s; semi-implicit, real water) in a one-cell-wide flume (smooth walls: plane strain; the quick pile in
-# the 0.10 m flume moves within 1% of it), one knob changed at a time around the quick baseline (h = 2 cm,
-# 2 points per cell, uGIMP, α = 100, Kw = 2.2 GPa, T = 60 s): T and 2T; α = 100, 10, 1; h = 2 and 1 cm;
-# linear, uGIMP, cpGIMP; 2 and 3 points per cell; Kw real and lowered 10×. For each run: the onset (the slope
-# face's compliance, yade_mpm.analysis.compliance_onset) head and time, Bishop's onset head on the run's
-# own pressures (slides ≥ 3 cells deep), the face, toe and run-out at the end, and the solver's wall time.
-# Writes the table into doc/tradeoffs.md (between the PILE markers) and doc/figures/tradeoffs_pile.png.
+# Speed for accuracy of the sand pile (issue 15; not a test): the default pile (yade_mpm.sandpile.DEFAULT:
+# semi-implicit, capillary surface, one-cell plane-strain flume, Dupuit's starting table) on a laboratory
+# head rise, one knob changed at a time around the quick baseline (h = 2 cm, 2 points per cell, uGIMP,
+# α = 100, the scene's Kw = 2.2e8 Pa): ramp time T and 2T; α = 100, 10, 1; h = 2 and 1 cm; linear, uGIMP,
+# cpGIMP; 2 and 3 points per cell; Kw lowered and real (2.2e9 Pa). The history is the CI's (3 s at 0.03 m,
+# T = 20 s rise to 0.12 m, 5 s held; PILE_TRADEOFF_RAMP_TIME sets T): on the default 60 s rise the α = 1
+# run alone would take over two hours on one core. For each run: the kinetic onset (sustained growth of the
+# kinetic energy, yade_mpm.analysis) and the compliance onset (head and time after the rise began), Bishop's
+# onset head on the run's own pressures, the toe at the end, the run-out of the toe front, and the solver's
+# wall time. Writes the table into doc/tradeoffs.md (between the PILE markers) and doc/figures/tradeoffs_pile.png.
 # Runs are kept in PILE_TRADEOFF_RUNS (default a temporary directory); a run whose summary.json is there
-# is not run again. About 80 minutes on 2 cores (α = 1 alone about 30).
+# is not run again. Each run on PILE_TRADEOFF_THREADS threads (default 1: wall times comparable when two
+# sweeps share the machine). About 2 hours on one core (α = 1 alone 50 minutes, h = 1 cm 25).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${MPM_BUILD_DIR:-$root/build}"
 [ -f "$build/python/yade_mpm/_yade_mpm.so" ] || "$root/scripts/build.sh"
 runs="${PILE_TRADEOFF_RUNS:-$(mktemp -d)}"
+threads="${PILE_TRADEOFF_THREADS:-1}"
+ramp="${PILE_TRADEOFF_RAMP_TIME:-20}"  # T [s]
+history=(--settle-time 3 --ramp-time "$ramp" --hold-time 5)
 mkdir -p "$runs"
-base=(--submerged --scheme semi-implicit --crest-lid --lid-friction 0.7)
-# "reference" marks a knob's most accurate setting, which its other runs are set against (else the baseline)
-#      name         knob               setting  role       arguments beyond the baseline's
+# "reference" marks a knob's most accurate setting, which its other runs are set against (else the baseline);
+# cheapest first, so that an interrupted sweep leaves the most rows
+#      name         knob               setting  role       arguments beyond the baseline's (--quick and the history; a later --ramp-time wins)
 configs=(
-  "baseline     baseline           quick    -          --quick --flume-width 0.02 --inertia-scale 100"
-  "ramp2T       ramp_time          2T       -          --quick --flume-width 0.02 --inertia-scale 100 --ramp-time 120"
-  "alpha10      inertia_scale      α=10     -          --quick --flume-width 0.02 --inertia-scale 10"
-  "full         cell_size          h=1cm    reference  --cell 0.01 --flume-width 0.01 --inertia-scale 100"
-  "linear       shape_function     linear   -          --quick --flume-width 0.02 --inertia-scale 100 --shape-function linear"
-  "cpgimp       shape_function     cpGIMP   -          --quick --flume-width 0.02 --inertia-scale 100 --shape-function cpGIMP"
-  "ppc3         points_per_cell    3        reference  --quick --flume-width 0.02 --inertia-scale 100 --points-per-cell 3"
-  "kwlow        water_bulk_modulus Kw/10    -          --quick --flume-width 0.02 --inertia-scale 100 --water-bulk-modulus 2.2e8"
-  "alpha1       inertia_scale      α=1      reference  --quick --flume-width 0.02 --inertia-scale 1"
+  "baseline     baseline           quick    -          "
+  "kwreal       water_bulk_modulus Kw=2.2GPa reference --water-bulk-modulus 2.2e9"
+  "linear       shape_function     linear   -          --shape-function linear"
+  "cpgimp       shape_function     cpGIMP   -          --shape-function cpGIMP"
+  "ramp2T       ramp_time          2T       -          --ramp-time $((2 * ramp))"
+  "ppc3         points_per_cell    3        reference  --points-per-cell 3"
+  "alpha10      inertia_scale      α=10     -          --inertia-scale 10"
+  "full         cell_size          h=1cm    reference  --cell 0.01"
+  "alpha1       inertia_scale      α=1      reference  --inertia-scale 1"
 )
 for config in "${configs[@]}"; do
   read -r name knob setting role extra <<< "$config"
   out="$runs/$name"
+  args=(--quick "${history[@]}")
   if [ ! -f "$out/summary.json" ]; then
-    echo "== $name: examples/sandpile/sandpile.py ${base[*]} $extra"
+    echo "== $name: examples/sandpile/sandpile.py ${args[*]} $extra"
     # shellcheck disable=SC2086
-    PYTHONPATH="$build/python" HOME="$runs" yade-double -j2 -n -x "$root/examples/sandpile/sandpile.py" "${base[@]}" $extra --out "$out" \
-      > "$runs/$name.log" 2>&1 || { tail -30 "$runs/$name.log"; exit 1; }
+    OMP_NUM_THREADS="$threads" PYTHONPATH="$build/python" HOME="$runs" yade-double -j"$threads" -n -x "$root/examples/sandpile/sandpile.py" \
+      "${args[@]}" $extra --out "$out" > "$runs/$name.log" 2>&1 || { tail -30 "$runs/$name.log"; exit 1; }
   fi
   echo "$name $knob $setting $([ "$role" = reference ] && echo reference)" >> "$runs/index.new"
 done
 # the baseline is also the setting of the knobs whose reference is another run
-printf "baseline inertia_scale α=100\nbaseline cell_size h=2cm\nbaseline points_per_cell 2\n" >> "$runs/index.new"
+printf "baseline inertia_scale α=100\nbaseline cell_size h=2cm\nbaseline points_per_cell 2\nbaseline water_bulk_modulus Kw=0.22GPa\nbaseline ramp_time T\nbaseline shape_function uGIMP\n" >> "$runs/index.new"
 mv "$runs/index.new" "$runs/index"
-machine="$(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(date -u +%Y-%m-%d)"
+machine="$(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(date -u +%Y-%m-%d), $threads thread(s) per run"
 PYTHONPATH="$build/python" /usr/bin/python3 -m yade_mpm.pile_tradeoffs --runs "$runs" --machine "$machine" \
   --doc "$root/doc/tradeoffs.md" --figure "$root/doc/figures/tradeoffs_pile.png"

@@ -5,11 +5,13 @@
 DIR holds runs of examples/sandpile/sandpile.py (each a directory with summary.json and time_series.csv)
 and an `index` file, a line per run: `name knob setting [reference]` (scripts/tradeoffs-pile.sh writes
 both). Each knob's runs are set against its run marked `reference` — the most accurate setting where
-there is one (α = 1, the finer cell, more points per cell) — or else against the run named `baseline`,
-on three answers: the excess head over the still water at the onset (the slope face's compliance,
-yade_mpm.analysis.compliance_onset), the onset's time after the rise began, and the slope face's
-displacement when the head reaches its end; a setting within `SAFE` of its reference on all three (the
-onset within one record, its resolution) is a safe speed setting.
+there is one (α = 1, the finer cell, more points per cell, real water) — or else against the run named
+`baseline`, on the three answers the issue names: the head at the onset of failure (the example's
+`onset_head_m`: the slope face's compliance, yade_mpm.analysis.compliance_onset; over the still water
+where there is one), the onset's time after the rise began, and the run-out of the toe front at the end.
+A setting within `SAFE` of its reference on all three (the onset within one record, its resolution) is a
+safe speed setting. The kinetic onset (sustained growth of the solid's kinetic energy), Bishop's F = 1
+head on the run's own pressures and the toe's displacement at the end are listed beside them.
 """
 import argparse
 import json
@@ -26,12 +28,14 @@ HEADING = "## The sand pile: cost knobs against its answer"  # its section of do
 SAFE = 0.05  # relative change of every answer that still counts as "the same" [-]
 
 
-def _at(columns, key, time):
-    """Column `key` at `time` [s], linear between records; None if the run ended before it."""
-    t = columns["time_s"]
-    if len(t) == 0 or time > t[-1] + 1e-9:
-        return None
-    return float(np.interp(time, t, columns[key]))
+def _head(onset, still):
+    """The head [m] of an onset record (over the still water `still`), None if there was no onset."""
+    return None if onset is None else onset["head_m"] - still
+
+
+def _time_after(onset, scene):
+    """The time of an onset record after the rise began [s], None if there was no onset."""
+    return None if onset is None else onset["time_s"] - scene["settle_time"]
 
 
 def collect(runs_dir):
@@ -46,21 +50,23 @@ def collect(runs_dir):
             summary, columns = read_run(os.path.join(runs_dir, name))
             scene = summary["scene"]
             still = scene["still_water_level"] if scene.get("still_water_level") is not None else 0.0
-            onset = summary.get("onset")
-            rise_end = scene["settle_time"] + scene["head_ramp_time"]  # every run is compared at its full head
             rows.append({
                 "name": name, "knob": knob, "setting": setting, "reference": fields[3:4] == ["reference"],
                 "cell_size_m": summary["cell_size_m"], "points_per_cell": summary.get("points_per_cell"),
                 "shape_function": summary.get("shape_function"), "inertia_scale": summary["inertia_scale"],
                 "flume_width_m": scene["flume_width"], "ramp_time_s": scene["head_ramp_time"], "scheme": summary["scheme"],
-                "onset_excess_head_m": None if onset is None else onset["head_m"] - still,
-                "onset_time_after_rise_s": None if onset is None else onset["time_s"] - scene["settle_time"],
-                "lem_deep_onset_excess_head_m": None if summary.get("lem_deep_onset_head_m") is None else summary["lem_deep_onset_head_m"] - still,
-                "face_at_end_of_rise_m": _at(columns, "face_displacement_m", rise_end),
-                "toe_at_end_of_rise_m": _at(columns, "toe_displacement_m", rise_end),
+                "settle_time_s": scene["settle_time"], "hold_time_s": scene["hold_time"],
+                "head_start_m": scene["head_start"] - still, "head_end_m": scene["head_end"] - still,
+                "onset_head_m": _head(summary.get("onset"), still),
+                "onset_time_after_rise_s": _time_after(summary.get("onset"), scene),
+                "kinetic_onset_head_m": _head(summary.get("kinetic_onset"), still),
+                "lem_onset_head_m": None if summary.get("lem_onset_head_m") is None else summary["lem_onset_head_m"] - still,
+                "toe_at_end_m": float(columns["toe_displacement_m"][-1]) if len(columns["time_s"]) else None,
                 "runout_m": summary.get("runout_m"),
                 "simulated_time_s": summary["simulated_time_s"],
                 "solver_time_s": summary["solver_time_s"],
+                # the cost: CPU time, which other runs sharing the machine do not inflate as they do the wall time
+                "solver_cpu_time_s": summary.get("solver_cpu_time_s"),
                 "solid_points": summary["solid_points"],
                 "inertia_scale_release_time_s": summary.get("inertia_scale_release_time_s"),
                 "stopped_unstable": summary.get("stopped_unstable"),
@@ -72,7 +78,7 @@ def collect(runs_dir):
     return rows
 
 
-ANSWERS = ("onset_excess_head_m", "onset_time_after_rise_s", "face_at_end_of_rise_m")
+ANSWERS = ("onset_head_m", "onset_time_after_rise_s", "runout_m")
 
 
 def relative_changes(rows):
@@ -99,7 +105,7 @@ def _within(r, reference, key, change):
     if abs(change) < SAFE:
         return True
     step = {"onset_time_after_rise_s": lambda x: x["record_interval_s"],
-            "onset_excess_head_m": lambda x: x["record_interval_s"] * x["head_rate_m_per_s"]}.get(key)
+            "onset_head_m": lambda x: x["record_interval_s"] * x["head_rate_m_per_s"]}.get(key)
     return step is not None and abs(r[key] - reference[key]) <= max(step(r), step(reference)) * (1 + 1e-9)
 
 
@@ -120,19 +126,32 @@ def _f(value, fmt):
     return "–" if value is None or (isinstance(value, float) and math.isnan(value)) else fmt % value
 
 
+def _cost(r):
+    """A run's cost [s]: the solver's CPU time, or its wall time where the run did not record it."""
+    return r["solver_cpu_time_s"] if r["solver_cpu_time_s"] is not None else r["solver_time_s"]
+
+
+def _mm(value, fmt="%.1f"):
+    return _f(None if value is None else 1e3 * value, fmt)
+
+
 def table(rows, machine):
     """The Markdown section written between the PILE markers of doc/tradeoffs.md."""
     changes = relative_changes(rows)
     base = next((r for r in rows if r["name"] == "baseline"), rows[0])
-    lines = ["Measured on %s by `bash scripts/tradeoffs-pile.sh`, one run each. The submerged, lidded pile on the laboratory head "
-             "history in a flume %.3g m wide (smooth walls: plane strain), %s; one knob changed at a time around the baseline (h = %.3g m, "
-             "%s points per cell, %s, α = %g, T = %.0f s). Onset: the slope face's compliance "
-             "(excess head over the still water, time after the rise began); Bishop: slides ≥ 3 cells deep on the run's own "
-             "pressures; Δ: change against the knob's reference run (its most accurate setting where run, else the baseline)."
-             % (machine, base["flume_width_m"], base["scheme"], base["cell_size_m"], base["points_per_cell"] or "–", base["shape_function"] or "–",
-                base["inertia_scale"], base["ramp_time_s"]),
+    lines = ["Measured on %s by `bash scripts/tradeoffs-pile.sh`, one run each (cost: the solver's CPU time, one thread per run). The pile in a flume %.3g m wide (smooth walls: "
+             "plane strain), %s, on the head history %.0f s at %.0f mm, a rise to %.0f mm over T = %.0f s, %.0f s held; one knob "
+             "changed at a time around the baseline (h = %.3g m, %s points per cell, %s, α = %g). Onset: the slope face's "
+             "compliance (its displacement per unit head past 10× its elastic value; head and time after the rise began); "
+             "kinetic: the solid's kinetic energy grows at each of 5 records and tenfold; Bishop: F = 1 on the run's own "
+             "pressures (Davis' strength); run-out: the toe front's advance at the end; Δ: relative change against the knob's "
+             "reference run (its most accurate setting where run, else the baseline)."
+             % (machine, base["flume_width_m"], base["scheme"], base["settle_time_s"], 1e3 * base["head_start_m"], 1e3 * base["head_end_m"],
+                base["ramp_time_s"], base["hold_time_s"], base["cell_size_m"], base["points_per_cell"] or "–", base["shape_function"] or "–",
+                base["inertia_scale"]),
              "",
-             "| knob | setting | solid points | solver wall time [s] | onset excess head [mm] | Δ | onset time after rise [s] | Δ | Bishop onset excess head [mm] | face at full head [mm] | Δ | toe at full head [mm] | run-out at the end [mm] | note |",
+             "| knob | setting | solid points | solver CPU time [s] | onset head [mm] | Δ | onset time after rise [s] | Δ | run-out [mm] | Δ "
+             "| kinetic onset head [mm] | Bishop F = 1 head [mm] | toe at the end [mm] | note |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r, (reference, c) in zip(rows, changes):
         note = []
@@ -142,16 +161,17 @@ def table(rows, machine):
             note.append("α released at %.1f s" % r["inertia_scale_release_time_s"])
         if r["simulated_time_s"] < 0.999 * r["planned_time_s"]:
             note.append("ended at %.1f of %.0f s" % (r["simulated_time_s"], r["planned_time_s"]))
+        if r["solver_cpu_time_s"] is None:
+            note.append("wall time (no CPU time recorded)")
         if reference == r["name"]:
             note.append("reference")
+        own = reference == r["name"]
         lines.append("| %s | %s | %d | %.0f | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
-            r["knob"].replace("_", " "), r["setting"], r["solid_points"], r["solver_time_s"],
-            _f(None if r["onset_excess_head_m"] is None else 1e3 * r["onset_excess_head_m"], "%.1f"), _f(None if reference == r["name"] else c["onset_excess_head_m"], "%+.3f"),
-            _f(r["onset_time_after_rise_s"], "%.1f"), _f(None if reference == r["name"] else c["onset_time_after_rise_s"], "%+.3f"),
-            _f(None if r["lem_deep_onset_excess_head_m"] is None else 1e3 * r["lem_deep_onset_excess_head_m"], "%.1f"),
-            _f(None if r["face_at_end_of_rise_m"] is None else 1e3 * r["face_at_end_of_rise_m"], "%.2f"),
-            _f(None if reference == r["name"] else c["face_at_end_of_rise_m"], "%+.3f"),
-            _f(None if r["toe_at_end_of_rise_m"] is None else 1e3 * r["toe_at_end_of_rise_m"], "%.2f"), _f(None if r["runout_m"] is None else 1e3 * r["runout_m"], "%.1f"), "; ".join(note)))
+            r["knob"].replace("_", " "), r["setting"], r["solid_points"], _cost(r),
+            _mm(r["onset_head_m"]), _f(None if own else c["onset_head_m"], "%+.3f"),
+            _f(r["onset_time_after_rise_s"], "%.1f"), _f(None if own else c["onset_time_after_rise_s"], "%+.3f"),
+            _mm(r["runout_m"]), _f(None if own else c["runout_m"], "%+.3f"),
+            _mm(r["kinetic_onset_head_m"]), _mm(r["lem_onset_head_m"]), _mm(r["toe_at_end_m"]), "; ".join(note)))
     verdicts = same_answer(rows, changes)
     safe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if ok]
     unsafe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if not ok]
@@ -165,8 +185,8 @@ def table(rows, machine):
 
 
 def figure(path, rows):
-    """Onset excess head and the face's displacement at the full head against the solver's wall time, one
-    marker per run, labelled with its setting (hollow: the run stopped as unstable)."""
+    """The onset head and the run-out against the solver's CPU time, one marker per run, labelled with its
+    setting (hollow: the run stopped as unstable)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -176,18 +196,16 @@ def figure(path, rows):
         if r["name"] in seen:
             continue
         seen.add(r["name"])
-        t, label, face = r["solver_time_s"], "baseline" if r["knob"] == "baseline" else r["setting"], "none" if r["stopped_unstable"] else None
-        if r["onset_excess_head_m"] is not None:
-            left.plot(t, 1e3 * r["onset_excess_head_m"], "o", color="C0", mfc=face)
-            left.annotate(label, (t, 1e3 * r["onset_excess_head_m"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
-        if r["face_at_end_of_rise_m"] is not None:
-            right.plot(t, 1e3 * r["face_at_end_of_rise_m"], "s", color="C1", mfc=face)
-            right.annotate(label, (t, 1e3 * r["face_at_end_of_rise_m"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
-    for ax, label in ((left, "onset excess head [mm]"), (right, "slope face displacement at the full head [mm]")):
+        t, label, face = _cost(r), "baseline" if r["knob"] == "baseline" else r["setting"], "none" if r["stopped_unstable"] else None
+        for ax, key, marker, colour in ((left, "onset_head_m", "o", "C0"), (right, "runout_m", "s", "C1")):
+            if r[key] is not None:
+                ax.plot(t, 1e3 * r[key], marker, color=colour, mfc=face)
+                ax.annotate(label, (t, 1e3 * r[key]), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    for ax, label in ((left, "head at the onset of failure [mm]"), (right, "run-out of the toe front at the end [mm]")):
         ax.set_xscale("log")
-        ax.set_xlabel("solver wall time [s]")
+        ax.set_xlabel("solver CPU time [s]")
         ax.set_ylabel(label)
-    fig.suptitle("the submerged pile on the laboratory head history: answer against cost (one knob at a time)", fontsize=9)
+    fig.suptitle("the sand pile: answer against cost (one knob at a time)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
