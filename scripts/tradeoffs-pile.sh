@@ -10,8 +10,11 @@
 # onset head on the run's own pressures, the toe at the end, the run-out of the toe front, and the solver's
 # wall time. Writes the table into doc/tradeoffs.md (between the PILE markers) and doc/figures/tradeoffs_pile.png.
 # Runs are kept in PILE_TRADEOFF_RUNS (default a temporary directory); a run whose summary.json is there
-# is not run again. Each run on PILE_TRADEOFF_THREADS threads (default 1: wall times comparable when two
-# sweeps share the machine). About 2 hours on one core (α = 1 alone 50 minutes, h = 1 cm 25).
+# is not run again; PILE_TRADEOFF_ONLY (names, e.g. "baseline alpha10") runs and tabulates only those;
+# PILE_TRADEOFF_MAX_WALL_TIME (s) ends a run at its first record past it (the example's --max-wall-time: once
+# α is released the step is ten times smaller; the table marks where such a run ended). Each
+# run on PILE_TRADEOFF_THREADS threads (default 1); the cost compared is the solver's CPU time, which runs
+# sharing the machine do not stretch. About 2 hours on one core (α = 1 alone 50 minutes, h = 1 cm 25).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${MPM_BUILD_DIR:-$root/build}"
@@ -37,8 +40,10 @@ configs=(
 )
 for config in "${configs[@]}"; do
   read -r name knob setting role extra <<< "$config"
+  if [ -n "${PILE_TRADEOFF_ONLY:-}" ] && [[ " $PILE_TRADEOFF_ONLY " != *" $name "* ]]; then continue; fi
   out="$runs/$name"
   args=(--quick "${history[@]}")
+  [ -z "${PILE_TRADEOFF_MAX_WALL_TIME:-}" ] || args+=(--max-wall-time "$PILE_TRADEOFF_MAX_WALL_TIME")
   if [ ! -f "$out/summary.json" ]; then
     echo "== $name: examples/sandpile/sandpile.py ${args[*]} $extra"
     # shellcheck disable=SC2086

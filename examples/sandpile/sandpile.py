@@ -41,7 +41,9 @@ Writes to DIR (default examples/sandpile/out[-quick]):
 The water mass balance (initial + injected = stored + removed) is checked at every record; the run
 stops with an error if it fails to close to 1e-9. If the solver stops the run as unstable (a point
 moving more than a cell in a step), everything is still written for the time reached and
-summary.json carries the solver's message under "stopped_unstable".
+summary.json carries the solver's message under "stopped_unstable". With --max-wall-time the run ends at
+the first record past that wall time, writes everything for the time reached and records the limit
+under "stopped_wall_time_limit_s".
 """
 import argparse
 import csv
@@ -65,6 +67,9 @@ parser.add_argument("--quick", action="store_true", help="2 cm cells: 7-9 min on
 parser.add_argument("--cell", type=float, help="cell size h [m] (default 0.02 quick, 0.01 full)")
 parser.add_argument("--duration", type=float, help="stop after this time [s] (default: the whole head history)")
 parser.add_argument("--out", help="output directory")
+parser.add_argument("--max-wall-time", type=float, metavar="S",
+                    help="end the run at the first record after S seconds of wall time [s], writing every output for the "
+                         "time reached (default: no limit; e.g. the full mode, whose step shrinks tenfold once α is released)")
 parser.add_argument("--scheme", choices=("explicit", "semi-implicit"), default="semi-implicit",
                     help="semi-implicit (default: no relaxation, the capillary surface, the laboratory head history) or explicit "
                          "(the suction-holding seepage face and the relaxations of theory.md eqs. 4.17b-c; its step follows the water's "
@@ -194,6 +199,8 @@ if not 0 < CELL <= SCENE.pile_height / 4:
     raise ValueError("--cell = %r m is outside the valid range (0, %g] (at least 4 cells over the pile height)" % (CELL, SCENE.pile_height / 4))
 if not DURATION > 0:
     raise ValueError("--duration = %r s is outside the valid range (0, inf)" % DURATION)
+if args.max_wall_time is not None and not args.max_wall_time > 0:
+    raise ValueError("--max-wall-time = %r s is outside the valid range (0, inf)" % args.max_wall_time)
 if not args.inertia_scale >= 1:
     raise ValueError("--inertia-scale = %r is outside the valid range [1, inf)" % args.inertia_scale)
 SCENE.validate()
@@ -318,6 +325,7 @@ lem_records = []  # (time, head, critical circle, critical circle ≥ DEEP_SLIDE
 failure = None
 settled = None
 stopped = None  # the solver's message if the run went unstable: what was recorded up to then is kept
+stopped_by_wall_time = None  # the --max-wall-time limit [s] if it ended the run
 wall_start = time.time()
 solver_time = 0.0  # wall time in the steps (HDF5 frames included), without this script's records and checks [s]
 solver_cpu_time = 0.0  # the same in CPU time of all the process's threads: the cost when other runs share the machine [s]
@@ -388,6 +396,10 @@ while O.time < DURATION - 0.5 * O.dt:  # O.time sums O.dt: thousands of round-of
           % (O.time, row["head_m"], row["toe_displacement_m"], row["face_displacement_m"], row["max_solid_speed_m_per_s"], fluid.count, residual,
              engine.inertiaScale, row["lem_factor_of_safety"], time.time() - wall_start),
           flush=True)
+    if args.max_wall_time is not None and time.time() - wall_start > args.max_wall_time and O.time < DURATION - 0.5 * O.dt:
+        stopped_by_wall_time = args.max_wall_time
+        print("stopped: wall time past --max-wall-time = %g s at t = %.3f s of %g s" % (args.max_wall_time, O.time, DURATION), flush=True)
+        break
 run_time = time.time() - wall_start
 snapshots["end"] = (O.time, fluid.pos.copy(), fluid.porePressure.copy())
 if failure is None:
@@ -475,6 +487,7 @@ summary = {
     "gravity_m_per_s2": GRAVITY.tolist(),
     "simulated_time_s": O.time,
     "stopped_unstable": stopped,
+    "stopped_wall_time_limit_s": stopped_by_wall_time,
     "scheme": args.scheme,
     "inertia_scale": args.inertia_scale,
     "inertia_scale_release": args.inertia_release,

@@ -70,6 +70,7 @@ def collect(runs_dir):
                 "solid_points": summary["solid_points"],
                 "inertia_scale_release_time_s": summary.get("inertia_scale_release_time_s"),
                 "stopped_unstable": summary.get("stopped_unstable"),
+                "stopped_wall_time_limit_s": summary.get("stopped_wall_time_limit_s"),
                 "planned_time_s": scene["settle_time"] + scene["head_ramp_time"] + scene["hold_time"],
                 # the onset is read at the records: one record interval is its resolution, in time and in head
                 "record_interval_s": float(np.median(np.diff(columns["time_s"]))) if len(columns["time_s"]) > 1 else math.inf,
@@ -118,7 +119,9 @@ def same_answer(rows, changes):
     for r, (reference, change) in zip(rows, changes):
         if r["knob"] == "baseline" or reference is None or reference == r["name"]:
             continue
-        out.append((r, r["stopped_unstable"] is None and all(_within(r, by_name[reference], k, v) for k, v in change.items())))
+        # a run that ended early (unstable, or at its wall-time limit) has no run-out to compare
+        complete = r["stopped_unstable"] is None and r["simulated_time_s"] >= 0.999 * r["planned_time_s"]
+        out.append((r, complete and all(_within(r, by_name[reference], k, v) for k, v in change.items())))
     return out
 
 
@@ -160,7 +163,8 @@ def table(rows, machine):
         if r["inertia_scale_release_time_s"] is not None:
             note.append("α released at %.1f s" % r["inertia_scale_release_time_s"])
         if r["simulated_time_s"] < 0.999 * r["planned_time_s"]:
-            note.append("ended at %.1f of %.0f s" % (r["simulated_time_s"], r["planned_time_s"]))
+            note.append("ended at %.1f of %.0f s%s" % (r["simulated_time_s"], r["planned_time_s"],
+                                                        " (its wall-time limit)" if r["stopped_wall_time_limit_s"] else ""))
         if r["solver_cpu_time_s"] is None:
             note.append("wall time (no CPU time recorded)")
         if reference == r["name"]:

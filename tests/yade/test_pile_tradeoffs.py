@@ -118,3 +118,16 @@ def test_the_cost_is_the_cpu_time_and_a_run_without_it_says_so(runs):
     assert "| baseline | quick | 500 | 150 |" in text
     line = next(l for l in text.splitlines() if l.startswith("| inertia scale | α=10 |"))
     assert "| 900 |" in line and "wall time (no CPU time recorded)" in line
+
+
+def test_a_run_that_ended_early_has_no_verdict_of_safe(runs):
+    """α = 10 matches α = 1 on every answer, but a run cut short at its wall-time limit has no run-out at
+    the end to compare: not a safe setting, and its row says where it ended."""
+    summary_path = runs / "alpha10" / "summary.json"
+    summary = json.loads(summary_path.read_text())
+    summary.update(simulated_time_s=40.0, stopped_wall_time_limit_s=600.0)
+    summary_path.write_text(json.dumps(summary))
+    rows = pile_tradeoffs.collect(runs)
+    assert _verdicts(rows)[("inertia_scale", "α=10")] is False
+    line = next(l for l in pile_tradeoffs.table(rows, "test machine") if l.startswith("| inertia scale | α=10 |"))
+    assert "ended at 40.0 of 81 s (its wall-time limit)" in line

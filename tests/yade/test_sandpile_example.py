@@ -263,3 +263,29 @@ def test_explicit_scheme_runs_the_compressed_history_and_stands_while_settling(t
     assert summary["scheme"] == "explicit" and summary["capillary_surface"] is False and summary["inertia_scale"] == 1.0
     assert abs(summary["stable_before_rise"]["toe_displacement_m"]) < 1e-4
     assert abs(summary["stable_before_rise"]["face_displacement_m"]) < 1e-4
+
+
+def _example(tmp_path, *arguments):
+    return subprocess.run(["yade-double", "-j1", "-n", "-x", str(pathlib.Path(__file__).parents[2] / "examples" / "sandpile" / "sandpile.py"),
+                           *arguments, "--out", str(tmp_path)],
+                          capture_output=True, text=True, timeout=300, env=dict(os.environ, HOME=str(tmp_path)), stdin=subprocess.DEVNULL)
+
+
+def test_a_wall_time_limit_ends_the_run_at_a_record_and_keeps_its_outputs(tmp_path):
+    """--max-wall-time ends the run at the first record past it and still writes every output for the time
+    reached, saying why in summary.json (the full mode's history takes hours once α is released). A
+    limit that is not positive is refused before any work, naming the option, its value and the range."""
+    refused = _example(tmp_path / "refused", "--quick", "--max-wall-time", "-1")
+    assert refused.returncode != 0 and "--max-wall-time = -1.0 s is outside the valid range (0, inf)" in refused.stdout + refused.stderr
+    assert not (tmp_path / "refused" / "summary.json").exists()
+    done = _example(tmp_path, "--quick", "--scheme", "explicit", "--duration", "0.05", "--max-wall-time", "1e-6")
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    with open(tmp_path / "summary.json") as f:
+        summary = json.load(f)
+    assert summary["stopped_wall_time_limit_s"] == 1e-6 and summary["stopped_unstable"] is None
+    with open(tmp_path / "time_series.csv") as f:
+        records = list(csv.DictReader(f))
+    assert len(records) == 1 and summary["simulated_time_s"] == pytest.approx(float(records[0]["time_s"]))
+    assert summary["simulated_time_s"] < 0.05
+    for name in ("time_series.png", "sandpile.h5"):
+        assert (tmp_path / name).exists(), name
