@@ -95,7 +95,7 @@ class SandPileScene:
         the level (no seepage at the start). This is the state the pile is in once the starting head
         has been held long enough, which the horizontal table at head_start is not: near the toe, where
         the ground lies below head_start, that table puts positive pore pressure on a drained surface,
-        and the pile starts draining at an exit gradient above one (doc/sandpile.md)."""
+        and the pile starts draining at an exit gradient above one (git history of doc/sandpile.md)."""
         x = np.asarray(x, dtype=float)
         if self.still_water_level is not None:
             return np.full(x.shape, float(self.still_water_level))
