@@ -40,8 +40,8 @@ Writes to DIR (default examples/sandpile/out[-quick]):
                                   (injected_kg, removed_kg, relative_residual), run time
 The water mass balance (initial + injected = stored + removed) is checked at every record; the run
 stops with an error if it fails to close to 1e-9. If the solver stops the run as unstable (a point
-moving more than a cell in a step), everything is still written for the time reached and
-summary.json carries the solver's message under "stopped_unstable". With --max-wall-time the run ends at
+moving more than a cell in a step, or a pressure solve that does not converge), everything is still
+written for the time reached and summary.json carries the solver's message under "stopped_unstable". With --max-wall-time the run ends at
 the first record past that wall time, writes everything for the time reached and records the limit
 under "stopped_wall_time_limit_s".
 """
@@ -346,9 +346,10 @@ while O.time < DURATION - 0.5 * O.dt:  # O.time sums O.dt: thousands of round-of
         solver_time += time.time() - steps_start
         solver_cpu_time += time.process_time() - steps_cpu_start
     except (RuntimeError, ValueError) as error:
-        # the solver went unstable (RuntimeError), or the soil rose above the still water (ValueError:
-        # the submerged model's premise, theory.md eq. 1.9, no longer holds): stop and keep what was recorded
-        if "unstable" not in str(error) and "needs the soil under the still water" not in str(error):
+        # the solver went unstable or its pressure solve did not converge (RuntimeError), or the soil rose
+        # above the still water (ValueError: the submerged model's premise, theory.md eq. 1.9, no longer
+        # holds): stop and keep what was recorded
+        if not any(reason in str(error) for reason in ("unstable", "did not converge", "needs the soil under the still water")):
             raise
         stopped = "t = %.4f s: %s" % (O.time, error)
         print("stopped: " + stopped, flush=True)
