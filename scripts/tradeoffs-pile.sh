@@ -38,6 +38,8 @@ configs=(
   "full         cell_size          h=1cm    reference  --cell 0.01"
   "alpha1       inertia_scale      α=1      reference  --inertia-scale 1"
 )
+: > "$runs/index.new"
+knobs_run=""
 for config in "${configs[@]}"; do
   read -r name knob setting role extra <<< "$config"
   if [ -n "${PILE_TRADEOFF_ONLY:-}" ] && [[ " $PILE_TRADEOFF_ONLY " != *" $name "* ]]; then continue; fi
@@ -51,9 +53,12 @@ for config in "${configs[@]}"; do
       "${args[@]}" $extra --out "$out" > "$runs/$name.log" 2>&1 || { tail -30 "$runs/$name.log"; exit 1; }
   fi
   echo "$name $knob $setting $([ "$role" = reference ] && echo reference)" >> "$runs/index.new"
+  knobs_run+=" $knob "
 done
-# the baseline is also the setting of the knobs whose reference is another run
-printf "baseline inertia_scale α=100\nbaseline cell_size h=2cm\nbaseline points_per_cell 2\nbaseline water_bulk_modulus Kw=0.22GPa\nbaseline ramp_time T\nbaseline shape_function uGIMP\n" >> "$runs/index.new"
+# the baseline is also the setting of each knob that was varied
+for pair in "inertia_scale α=100" "cell_size h=2cm" "points_per_cell 2" "water_bulk_modulus Kw=0.22GPa" "ramp_time T" "shape_function uGIMP"; do
+  [[ "${knobs_run:-}" != *" ${pair%% *} "* ]] || echo "baseline $pair" >> "$runs/index.new"
+done
 mv "$runs/index.new" "$runs/index"
 machine="$(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(date -u +%Y-%m-%d), $threads thread(s) per run"
 PYTHONPATH="$build/python" /usr/bin/python3 -m yade_mpm.pile_tradeoffs --runs "$runs" --machine "$machine" \
