@@ -82,6 +82,11 @@ def collect(runs_dir):
 ANSWERS = ("onset_head_m", "onset_time_after_rise_s", "runout_m")
 
 
+def _complete(r):
+    """Whether run r went through its whole history (not unstable, not stopped at a wall-time limit)."""
+    return r["stopped_unstable"] is None and r["simulated_time_s"] >= 0.999 * r["planned_time_s"]
+
+
 def relative_changes(rows):
     """Per run (a list in the order of `rows`): its knob's reference run's name and the relative
     change of each answer against it (None where an answer or the reference is missing)."""
@@ -93,6 +98,8 @@ def relative_changes(rows):
         changes = {}
         for key in ANSWERS:
             a, b = r[key], None if reference is None else reference[key]
+            if key == "runout_m" and not (_complete(r) and reference is not None and _complete(reference)):
+                a = None  # a run that ended early has no run-out at the end to compare
             changes[key] = None if a is None or b is None or b == 0 else (a - b) / abs(b)
         out.append((None if reference is None else reference["name"], changes))
     return out
@@ -119,9 +126,7 @@ def same_answer(rows, changes):
     for r, (reference, change) in zip(rows, changes):
         if r["knob"] == "baseline" or reference is None or reference == r["name"]:
             continue
-        # a run that ended early (unstable, or at its wall-time limit) has no run-out to compare
-        complete = r["stopped_unstable"] is None and r["simulated_time_s"] >= 0.999 * r["planned_time_s"]
-        out.append((r, complete and all(_within(r, by_name[reference], k, v) for k, v in change.items())))
+        out.append((r, _complete(r) and all(_within(r, by_name[reference], k, v) for k, v in change.items())))
     return out
 
 

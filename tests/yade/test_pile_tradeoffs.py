@@ -131,3 +131,17 @@ def test_a_run_that_ended_early_has_no_verdict_of_safe(runs):
     assert _verdicts(rows)[("inertia_scale", "α=10")] is False
     line = next(l for l in pile_tradeoffs.table(rows, "test machine") if l.startswith("| inertia scale | α=10 |"))
     assert "ended at 40.0 of 81 s (its wall-time limit)" in line
+
+
+def test_against_a_reference_that_ended_early_the_run_out_is_not_compared(runs):
+    """α = 1, the reference, cut short at its wall-time limit: α = 10's onset is still set against it, its
+    run-out is not (the reference has none at the end), so α = 10 gets no 'safe' verdict either."""
+    summary_path = runs / "alpha1" / "summary.json"
+    summary = json.loads(summary_path.read_text())
+    summary.update(simulated_time_s=40.0, stopped_wall_time_limit_s=600.0)
+    summary_path.write_text(json.dumps(summary))
+    rows = pile_tradeoffs.collect(runs)
+    names = [r["name"] for r in rows]
+    reference, change = pile_tradeoffs.relative_changes(rows)[names.index("alpha10")]
+    assert reference == "alpha1" and change["runout_m"] is None and change["onset_head_m"] == pytest.approx((0.0303 - 0.0306) / 0.0306)
+    assert _verdicts(rows)[("inertia_scale", "α=10")] is False
