@@ -195,17 +195,17 @@ def table(rows, machine):
 
 def figure(path, rows):
     """The onset head and the run-out against the solver's CPU time, one marker per run, labelled with its
-    setting (hollow: the run stopped as unstable)."""
+    setting (hollow: the run ended early, unstable or at its wall-time limit: its run-out is where it stopped)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
     seen = set()
-    for r in rows:  # each run once (the baseline is listed under several knobs); hollow: stopped as unstable
+    for r in rows:  # each run once (the baseline is listed under several knobs); hollow: ended early
         if r["name"] in seen:
             continue
         seen.add(r["name"])
-        t, label, face = _cost(r), "baseline" if r["knob"] == "baseline" else r["setting"], "none" if r["stopped_unstable"] else None
+        t, label, face = _cost(r), "baseline" if r["knob"] == "baseline" else r["setting"], None if _complete(r) else "none"
         for ax, key, marker, colour in ((left, "onset_head_m", "o", "C0"), (right, "runout_m", "s", "C1")):
             if r[key] is not None:
                 ax.plot(t, 1e3 * r[key], marker, color=colour, mfc=face)
