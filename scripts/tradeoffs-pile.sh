@@ -5,16 +5,17 @@
 # α = 100, the scene's Kw = 2.2e8 Pa): ramp time T and 2T; α = 100, 10, 1; h = 2 and 1 cm; linear, uGIMP,
 # cpGIMP; 2 and 3 points per cell; Kw lowered and real (2.2e9 Pa). The history is the CI's (3 s at 0.03 m,
 # T = 20 s rise to 0.12 m, 5 s held; PILE_TRADEOFF_RAMP_TIME sets T): on the default 60 s rise the α = 1
-# run alone would take over two hours on one core. For each run: the kinetic onset (sustained growth of the
-# kinetic energy, yade_mpm.analysis) and the compliance onset (head and time after the rise began), Bishop's
-# onset head on the run's own pressures, the toe at the end, the run-out of the toe front, and the solver's
-# wall time. Writes the table into doc/tradeoffs.md (between the PILE markers) and doc/figures/tradeoffs_pile.png.
+# run alone would take over two hours on one core. For each run (yade_mpm.pile_tradeoffs): the onset (the
+# slope face's compliance: head and time after the rise began), the run-out of the toe front, beside them the
+# kinetic onset, Bishop's F = 1 head on the run's own pressures and the toe at the end, and the solver's CPU
+# time. Writes the table into doc/tradeoffs.md (between the PILE markers) and doc/figures/tradeoffs_pile.png.
 # Runs are kept in PILE_TRADEOFF_RUNS (default a temporary directory); a run whose summary.json is there
 # is not run again; PILE_TRADEOFF_ONLY (names, e.g. "baseline alpha10") runs and tabulates only those;
 # PILE_TRADEOFF_MAX_WALL_TIME (s) ends a run at its first record past it (the example's --max-wall-time: once
 # α is released the step is ten times smaller; the table marks where such a run ended). Each
 # run on PILE_TRADEOFF_THREADS threads (default 1); the cost compared is the solver's CPU time, which runs
-# sharing the machine do not stretch. About 2 hours on one core (α = 1 alone 50 minutes, h = 1 cm 25).
+# sharing the machine do not stretch. Measured 2026-11-28: about 30 CPU-minutes for the runs at α ≥ 10 and h = 2 cm
+# together, α = 1 about 30 more; h = 1 cm releases α at 10-12 s and then takes hours (set the wall-time limit).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${MPM_BUILD_DIR:-$root/build}"

@@ -147,7 +147,7 @@ def table(rows, machine):
     """The Markdown section written between the PILE markers of doc/tradeoffs.md."""
     changes = relative_changes(rows)
     base = next((r for r in rows if r["name"] == "baseline"), rows[0])
-    lines = ["Measured on %s by `bash scripts/tradeoffs-pile.sh`, one run each (cost: the solver's CPU time, one thread per run). The pile in a flume %.3g m wide (smooth walls: "
+    lines = ["Measured on %s by `bash scripts/tradeoffs-pile.sh`, one run each (cost: the solver's CPU time). The pile in a flume %.3g m wide (smooth walls: "
              "plane strain), %s, on the head history %.0f s at %.0f mm, a rise to %.0f mm over T = %.0f s, %.0f s held; one knob "
              "changed at a time around the baseline (h = %.3g m, %s points per cell, %s, α = %g). Onset: the slope face's "
              "compliance (its displacement per unit head past 10× its elastic value; head and time after the rise began); "

@@ -132,10 +132,11 @@ def test_limit_equilibrium_finds_a_slump_at_the_toe():
     volume = spacing ** 3
     solid = SimpleNamespace(pos=points, mass=np.full(len(points), (1 - s.porosity) * s.grain_density * volume))
     toe = points[:, 0] > s.toe_x() - 3 * cell
-    saturated_weight = ((1 - s.porosity) * s.grain_density + s.porosity * s.water_density) * 9.81  # [N/m³]
+    gravity = (0.0, 0.0, -9.81)  # [m s⁻²]
+    saturated_weight = ((1 - s.porosity) * s.grain_density + s.porosity * s.water_density) * -gravity[2]  # [N/m³]
     water = SimpleNamespace(pos=points[toe], mass=np.full(toe.sum(), s.porosity * s.water_density * volume),
                             porePressure=saturated_weight * (s.surface_height(points[toe, 0]) - points[toe, 2]))
-    circle = sandpile.limit_equilibrium(s, solid, water, (0.0, 0.0, -9.81), cell, spacing)
+    circle = sandpile.limit_equilibrium(s, solid, water, gravity, cell, spacing)
     where = circle.describe()
     assert circle.factor < 0.5, where
     assert where["from_x_m"] > s.toe_x() - 5 * cell and where["lowest_z_m"] < 2 * cell, where
