@@ -2,7 +2,8 @@
 # Speed for accuracy of the sand pile (issue 15; not a test): the default pile (yade_mpm.sandpile.DEFAULT:
 # semi-implicit, capillary surface, one-cell plane-strain flume, Dupuit's starting table) on a laboratory
 # head rise, one knob changed at a time around the quick baseline (h = 2 cm, 2 points per cell, uGIMP,
-# α = 100, the scene's Kw = 2.2e8 Pa): ramp time T and 2T; α = 100, 10, 1; h = 2 and 1 cm; linear, uGIMP,
+# α = 100, the scene's Kw = 2.2e8 Pa, timeStepFactor C = 0.5): ramp time T and 2T; α = 100, 10, 1, and α = 100
+# released at the inertia ratio ε = 0.01 instead of 0.1; C = 0.5, 0.25, 0.125; h = 2 and 1 cm; linear, uGIMP,
 # cpGIMP; 2 and 3 points per cell; Kw lowered and real (2.2e9 Pa). The history is the CI's (3 s at 0.03 m,
 # T = 20 s rise to 0.12 m, 5 s held; PILE_TRADEOFF_RAMP_TIME sets T): on the default 60 s rise the α = 1
 # run alone would take over two hours on one core. For each run (yade_mpm.pile_tradeoffs): the onset (the
@@ -14,8 +15,10 @@
 # PILE_TRADEOFF_MAX_WALL_TIME (s) ends a run at its first record past it (the example's --max-wall-time: once
 # α is released the step is ten times smaller; the table marks where such a run ended). Each
 # run on PILE_TRADEOFF_THREADS threads (default 1); the cost compared is the solver's CPU time, which runs
-# sharing the machine do not stretch. Measured 2026-11-28: about 30 CPU-minutes for the runs at α ≥ 10 and h = 2 cm
-# together, α = 1 about 30 more; h = 1 cm releases α at 10-12 s and then takes hours (set the wall-time limit).
+# sharing the machine do not stretch. Measured 2026-11-28 (CPU time): about 31 minutes for the runs at C = 0.5,
+# α ≥ 10 and h = 2 cm together; C = 0.25 and 0.125 17 more; α = 10 at C = 0.158 29; α released at ε = 0.01 25;
+# α = 1 about 30 (18 to its first 18.4 s); h = 1 cm releases α at 10-12 s and then takes hours (set the
+# wall-time limit).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${MPM_BUILD_DIR:-$root/build}"
@@ -26,6 +29,9 @@ ramp="${PILE_TRADEOFF_RAMP_TIME:-20}"  # T [s]
 history=(--settle-time 3 --ramp-time "$ramp" --hold-time 5)
 mkdir -p "$runs"
 # "reference" marks a knob's most accurate setting, which its other runs are set against (else the baseline);
+# the inertia scaling has none: the error of its runs is the step's, of order Δt/α with Δt ∝ √α (measured
+# 2026-11-28, doc/sandpile.md), so α = 1 at the baseline's timeStepFactor has ten times the baseline's step
+# error, and the α = 10 run at the baseline's Δt/α (alpha10dt) is the like-for-like one;
 # cheapest first, so that an interrupted sweep leaves the most rows
 #      name         knob               setting  role       arguments beyond the baseline's (--quick and the history; a later --ramp-time wins)
 configs=(
@@ -34,10 +40,14 @@ configs=(
   "linear       shape_function     linear   -          --shape-function linear"
   "cpgimp       shape_function     cpGIMP   -          --shape-function cpGIMP"
   "ramp2T       ramp_time          2T       -          --ramp-time $((2 * ramp))"
+  "dt025        time_step_factor   C=0.25   -          --time-step-factor 0.25"
   "ppc3         points_per_cell    3        reference  --points-per-cell 3"
+  "dt0125       time_step_factor   C=0.125  reference  --time-step-factor 0.125"
   "alpha10      inertia_scale      α=10     -          --inertia-scale 10"
+  "alpha10dt    inertia_scale      α=10,C=0.158 -      --inertia-scale 10 --time-step-factor 0.158"
   "full         cell_size          h=1cm    reference  --cell 0.01"
-  "alpha1       inertia_scale      α=1      reference  --inertia-scale 1"
+  "release001   inertia_scale      α=100,ε=0.01 -      --inertia-release 0.01"
+  "alpha1       inertia_scale      α=1      -          --inertia-scale 1"
 )
 : > "$runs/index.new"
 knobs_run=""
@@ -57,7 +67,7 @@ for config in "${configs[@]}"; do
   knobs_run+=" $knob "
 done
 # the baseline is also the setting of each knob that was varied
-for pair in "inertia_scale α=100" "cell_size h=2cm" "points_per_cell 2" "water_bulk_modulus Kw=0.22GPa" "ramp_time T" "shape_function uGIMP"; do
+for pair in "inertia_scale α=100" "time_step_factor C=0.5" "cell_size h=2cm" "points_per_cell 2" "water_bulk_modulus Kw=0.22GPa" "ramp_time T" "shape_function uGIMP"; do
   [[ "${knobs_run:-}" != *" ${pair%% *} "* ]] || echo "baseline $pair" >> "$runs/index.new"
 done
 mv "$runs/index.new" "$runs/index"

@@ -5,13 +5,16 @@
 DIR holds runs of examples/sandpile/sandpile.py (each a directory with summary.json and time_series.csv)
 and an `index` file, a line per run: `name knob setting [reference]` (scripts/tradeoffs-pile.sh writes
 both). Each knob's runs are set against its run marked `reference` — the most accurate setting where
-there is one (α = 1, the finer cell, more points per cell, real water) — or else against the run named
+there is one (the smallest timeStepFactor, the finer cell, more points per cell, real water; not α = 1: at
+a given timeStepFactor the step's error is of order Δt/α ∝ α^(−1/2), largest at α = 1, doc/sandpile.md) — or else against the run named
 `baseline`, on the three answers the issue names: the head at the onset of failure (the example's
 `onset_head_m`: the slope face's compliance, yade_mpm.analysis.compliance_onset; over the still water
 where there is one), the onset's time after the rise began, and the run-out of the toe front at the end.
 A setting within `SAFE` of its reference on all three (the onset within one record, its resolution) is a
-safe speed setting. The kinetic onset (sustained growth of the solid's kinetic energy), Bishop's F = 1
-head on the run's own pressures and the toe's displacement at the end are listed beside them.
+safe speed setting. The kinetic onset (sustained growth of the solid's kinetic energy), the head at which the
+lower slope face has moved 1% of the pile height (the slide on the millimetre scale, where the onset is read
+on micrometres), Bishop's F = 1 head on the run's own pressures and the toe's displacement at the end are
+listed beside them.
 """
 import argparse
 import json
@@ -60,6 +63,8 @@ def collect(runs_dir):
                 "onset_head_m": _head(summary.get("onset"), still),
                 "onset_time_after_rise_s": _time_after(summary.get("onset"), scene),
                 "kinetic_onset_head_m": _head(summary.get("kinetic_onset"), still),
+                # the developed slide on the millimetre scale: the head at which the lower slope face has moved 1% of H
+                "slide_head_m": _head(summary.get("failure"), still),
                 "lem_onset_head_m": None if summary.get("lem_onset_head_m") is None else summary["lem_onset_head_m"] - still,
                 "toe_at_end_m": float(columns["toe_displacement_m"][-1]) if len(columns["time_s"]) else None,
                 "runout_m": summary.get("runout_m"),
@@ -151,7 +156,9 @@ def table(rows, machine):
              "plane strain), %s, on the head history %.0f s at %.0f mm, a rise to %.0f mm over T = %.0f s, %.0f s held; one knob "
              "changed at a time around the baseline (h = %.3g m, %s points per cell, %s, α = %g). Onset: the slope face's "
              "compliance (its displacement per unit head past 10× its elastic value; head and time after the rise began); "
-             "kinetic: the solid's kinetic energy grows at each of 5 records and tenfold; Bishop: F = 1 on the run's own "
+             "kinetic: the solid's kinetic energy grows at each of 5 records and tenfold; face 1%% H: the head at which the lower "
+             "slope face's mean displacement passes 1%% of the pile height (the slide on the millimetre scale; the onset reads "
+             "micrometres); Bishop: F = 1 on the run's own "
              "pressures (Davis' strength); run-out: the toe front's advance at the end; Δ: relative change against the knob's "
              "reference run (its most accurate setting where run, else the baseline)."
              % (machine, base["flume_width_m"], base["scheme"], base["settle_time_s"], 1e3 * base["head_start_m"], 1e3 * base["head_end_m"],
@@ -159,8 +166,8 @@ def table(rows, machine):
                 base["inertia_scale"]),
              "",
              "| knob | setting | solid points | solver CPU time [s] | onset head [mm] | Δ | onset time after rise [s] | Δ | run-out [mm] | Δ "
-             "| kinetic onset head [mm] | Bishop F = 1 head [mm] | toe at the end [mm] | note |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| kinetic onset head [mm] | face 1% H head [mm] | Bishop F = 1 head [mm] | toe at the end [mm] | note |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r, (reference, c) in zip(rows, changes):
         note = []
         if r["stopped_unstable"]:
@@ -175,12 +182,12 @@ def table(rows, machine):
         if reference == r["name"]:
             note.append("reference")
         own = reference == r["name"]
-        lines.append("| %s | %s | %d | %.0f | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+        lines.append("| %s | %s | %d | %.0f | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
             r["knob"].replace("_", " "), r["setting"], r["solid_points"], _cost(r),
             _mm(r["onset_head_m"]), _f(None if own else c["onset_head_m"], "%+.3f"),
             _f(r["onset_time_after_rise_s"], "%.1f"), _f(None if own else c["onset_time_after_rise_s"], "%+.3f"),
             _mm(r["runout_m"]), _f(None if own else c["runout_m"], "%+.3f"),
-            _mm(r["kinetic_onset_head_m"]), _mm(r["lem_onset_head_m"]), _mm(r["toe_at_end_m"]), "; ".join(note)))
+            _mm(r["kinetic_onset_head_m"]), _mm(r["slide_head_m"]), _mm(r["lem_onset_head_m"]), _mm(r["toe_at_end_m"]), "; ".join(note)))
     verdicts = same_answer(rows, changes)
     safe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if ok]
     unsafe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if not ok]

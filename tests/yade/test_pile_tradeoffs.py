@@ -8,13 +8,15 @@ from yade_mpm import pile_tradeoffs
 
 def _run(directory, onset_head, onset_time, runout, solver_time, stopped=None, settle=1.0, still=0.15):
     """A run whose onset (the compliance criterion: head, time), run-out and solver time are given; the
-    kinetic onset 10 mm of head later, Bishop's F = 1 at 0.227 m, the toe at the end twice the run-out."""
+    kinetic onset 10 mm of head later, the face's 1% H slide 20 mm later, Bishop's F = 1 at 0.227 m, the toe
+    at the end twice the run-out."""
     directory.mkdir()
     summary = {"scene": {"still_water_level": still, "settle_time": settle, "head_start": 0.15, "head_end": 0.27, "head_ramp_time": 60.0,
                          "hold_time": 20.0, "flume_width": 0.02},
                "cell_size_m": 0.02, "points_per_cell": 2, "shape_function": "uGIMP", "inertia_scale": 100.0, "scheme": "semi-implicit",
                "onset": None if onset_head is None else {"head_m": onset_head, "time_s": onset_time},
                "kinetic_onset": None if onset_head is None else {"head_m": onset_head + 0.010, "time_s": onset_time + 5.0},
+               "failure": None if onset_head is None else {"head_m": onset_head + 0.020, "time_s": onset_time + 10.0},
                "lem_onset_head_m": 0.227, "runout_m": runout, "simulated_time_s": 81.0, "solver_time_s": 2 * solver_time,
                "solver_cpu_time_s": solver_time,
                "solid_points": 500, "inertia_scale_release_time_s": None, "stopped_unstable": stopped}
@@ -145,3 +147,17 @@ def test_against_a_reference_that_ended_early_the_run_out_is_not_compared(runs):
     reference, change = pile_tradeoffs.relative_changes(rows)[names.index("alpha10")]
     assert reference == "alpha1" and change["runout_m"] is None and change["onset_head_m"] == pytest.approx((0.0303 - 0.0306) / 0.0306)
     assert _verdicts(rows)[("inertia_scale", "α=10")] is False
+
+
+def test_the_slide_on_the_millimetre_scale_is_listed_over_the_still_water(runs):
+    """The head at which the face has moved 1% of H (summary "failure") is a column beside the onsets: the
+    baseline's 0.200 m over the 0.15 m still water reads 50.0 mm; a run with none reads "–"."""
+    rows = pile_tradeoffs.collect(runs)
+    by_name = {r["name"]: r for r in rows}
+    assert by_name["baseline"]["slide_head_m"] == pytest.approx(0.050) and by_name["kwlow"]["slide_head_m"] is None
+    lines = pile_tradeoffs.table(rows, "test machine")
+    header = [c.strip() for c in lines[2].split("|")]
+    baseline = [c.strip() for c in next(l for l in lines if l.startswith("| baseline |")).split("|")]
+    kwlow = [c.strip() for c in next(l for l in lines if "Kw/10" in l).split("|")]
+    column = header.index("face 1% H head [mm]")
+    assert baseline[column] == "50.0" and kwlow[column] == "–"
