@@ -17,8 +17,8 @@
 # run on PILE_TRADEOFF_THREADS threads (default 1); the cost compared is the solver's CPU time, which runs
 # sharing the machine do not stretch. Measured 2026-11-28 (CPU time): about 31 minutes for the runs at C = 0.5,
 # α ≥ 10 and h = 2 cm together; C = 0.25 and 0.125 17 more; α = 10 at C = 0.158 29; α released at ε = 0.01 25;
-# α = 1 about 30 (18 to its first 18.4 s); h = 1 cm 20. At h = 1 cm α is held (ε = ∞), as it is at
-# h = 2 cm, where the release never fires: there the toe's tip slumps from the starting head and would release
+# α = 1 about 30 (18 to its first 18.4 s); h = 1 cm 20. At h = 1 cm α is held (ε = ∞) as it stays at
+# h = 2 cm (where the release never fires): at 1 cm the toe's tip slumps from the starting head and would release
 # α at 10-12 s, after which each step costs ten times as much and the step's error, of order Δt/α, is ten
 # times larger (doc/sandpile.md), so the row would compare that, not the cell size.
 set -euo pipefail

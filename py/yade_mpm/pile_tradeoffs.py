@@ -6,8 +6,8 @@ DIR holds runs of examples/sandpile/sandpile.py (each a directory with summary.j
 and an `index` file, a line per run: `name knob setting [reference]` (scripts/tradeoffs-pile.sh writes
 both). Each knob's runs are set against its run marked `reference` — the most accurate setting where
 there is one (the smallest timeStepFactor, the finer cell, more points per cell, real water; not α = 1: at
-a given timeStepFactor the step's error is of order Δt/α ∝ α^(−1/2), largest at α = 1, doc/sandpile.md) — or else against the run named
-`baseline`, on the three answers the issue names: the head at the onset of failure (the example's
+a given timeStepFactor the step's error is of order Δt/α ∝ α^(−1/2), largest at α = 1, doc/sandpile.md) —
+or else against the run named `baseline`, on the three answers the issue names: the head at the onset of failure (the example's
 `onset_head_m`: the slope face's compliance, yade_mpm.analysis.compliance_onset; over the still water
 where there is one), the onset's time after the rise began, and the run-out of the toe front at the end.
 A setting within `SAFE` of its reference on all three (the onset within one record, its resolution) is a
