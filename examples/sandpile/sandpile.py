@@ -543,6 +543,9 @@ if SUBMERGED:  # excess pressures: at most the final excess head, no suction
 else:
     pmax = SCENE.water_density * G * SCENE.head_end  # hydrostatic at the base under the final head [Pa]
     pmin = -SCENE.water_density * G * (SCENE.pile_height - SCENE.head_start)  # suction at the crest at the start [Pa]
+# the colour scale must straddle 0 also where one side is empty (a head of 0, or of the pile's height): a tenth
+# of the other side's range then
+pmax, pmin = max(pmax, -0.1 * pmin), min(pmin, -0.1 * pmax)
 yade_mpm.plotting.pore_pressure_snapshots(os.path.join(OUT, "pore_pressure.png"),
                                           [(name, t, SCENE.head(t), pos, p) for name, (t, pos, p) in snapshots.items()], SCENE, x_max, (pmin, pmax))
 pos, vel = failure_state
