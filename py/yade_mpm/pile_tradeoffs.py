@@ -12,8 +12,8 @@ or else against the run named `baseline`, on the three answers the issue names: 
 where there is one), the onset's time after the rise began, and the run-out of the toe front at the end.
 A setting within `SAFE` of its reference on all three (the onset within one record, its resolution) is a
 safe speed setting. The kinetic onset (sustained growth of the solid's kinetic energy), the head at which the
-lower slope face has moved 1% of the pile height (the slide on the millimetre scale, where the onset is read
-on micrometres), Bishop's F = 1 head on the run's own pressures and the toe's displacement at the end are
+lower slope face has moved 1% of the pile height (how far runs have moved on a fixed millimetre scale, beside
+the onset, which is read on micrometres; a displacement, not an onset), Bishop's F = 1 head on the run's own pressures and the toe's displacement at the end are
 listed beside them.
 """
 import argparse
@@ -63,8 +63,8 @@ def collect(runs_dir):
                 "onset_head_m": _head(summary.get("onset"), still),
                 "onset_time_after_rise_s": _time_after(summary.get("onset"), scene),
                 "kinetic_onset_head_m": _head(summary.get("kinetic_onset"), still),
-                # the developed slide on the millimetre scale: the head at which the lower slope face has moved 1% of H
-                "slide_head_m": _head(summary.get("failure"), still),
+                # the head at which the lower slope face has moved 1% of H (the example's "failure" record)
+                "face_one_percent_head_m": _head(summary.get("failure"), still),
                 "lem_onset_head_m": None if summary.get("lem_onset_head_m") is None else summary["lem_onset_head_m"] - still,
                 "toe_at_end_m": float(columns["toe_displacement_m"][-1]) if len(columns["time_s"]) else None,
                 "runout_m": summary.get("runout_m"),
@@ -157,7 +157,7 @@ def table(rows, machine):
              "changed at a time around the baseline (h = %.3g m, %s points per cell, %s, α = %g). Onset: the slope face's "
              "compliance (its displacement per unit head past 10× its elastic value; head and time after the rise began); "
              "kinetic: the solid's kinetic energy grows at each of 5 records and tenfold; face 1%% H: the head at which the lower "
-             "slope face's mean displacement passes 1%% of the pile height (the slide on the millimetre scale; the onset reads "
+             "slope face's mean displacement passes 1%% of the pile height (a fixed displacement to compare runs by; the onset reads "
              "micrometres); Bishop: F = 1 on the run's own "
              "pressures (Davis' strength); run-out: the toe front's advance at the end; Δ: relative change against the knob's "
              "reference run (its most accurate setting where run, else the baseline)."
@@ -187,7 +187,7 @@ def table(rows, machine):
             _mm(r["onset_head_m"]), _f(None if own else c["onset_head_m"], "%+.3f"),
             _f(r["onset_time_after_rise_s"], "%.1f"), _f(None if own else c["onset_time_after_rise_s"], "%+.3f"),
             _mm(r["runout_m"]), _f(None if own else c["runout_m"], "%+.3f"),
-            _mm(r["kinetic_onset_head_m"]), _mm(r["slide_head_m"]), _mm(r["lem_onset_head_m"]), _mm(r["toe_at_end_m"]), "; ".join(note)))
+            _mm(r["kinetic_onset_head_m"]), _mm(r["face_one_percent_head_m"]), _mm(r["lem_onset_head_m"]), _mm(r["toe_at_end_m"]), "; ".join(note)))
     verdicts = same_answer(rows, changes)
     safe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if ok]
     unsafe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if not ok]

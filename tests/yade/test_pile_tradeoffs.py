@@ -8,7 +8,7 @@ from yade_mpm import pile_tradeoffs
 
 def _run(directory, onset_head, onset_time, runout, solver_time, stopped=None, settle=1.0, still=0.15):
     """A run whose onset (the compliance criterion: head, time), run-out and solver time are given; the
-    kinetic onset 10 mm of head later, the face's 1% H slide 20 mm later, Bishop's F = 1 at 0.227 m, the toe
+    kinetic onset 10 mm of head later, the face's 1% of H 20 mm later, Bishop's F = 1 at 0.227 m, the toe
     at the end twice the run-out."""
     directory.mkdir()
     summary = {"scene": {"still_water_level": still, "settle_time": settle, "head_start": 0.15, "head_end": 0.27, "head_ramp_time": 60.0,
@@ -149,12 +149,12 @@ def test_against_a_reference_that_ended_early_the_run_out_is_not_compared(runs):
     assert _verdicts(rows)[("inertia_scale", "α=10")] is False
 
 
-def test_the_slide_on_the_millimetre_scale_is_listed_over_the_still_water(runs):
+def test_the_head_at_which_the_face_has_moved_one_percent_of_h_is_listed_over_the_still_water(runs):
     """The head at which the face has moved 1% of H (summary "failure") is a column beside the onsets: the
     baseline's 0.200 m over the 0.15 m still water reads 50.0 mm; a run with none reads "–"."""
     rows = pile_tradeoffs.collect(runs)
     by_name = {r["name"]: r for r in rows}
-    assert by_name["baseline"]["slide_head_m"] == pytest.approx(0.050) and by_name["kwlow"]["slide_head_m"] is None
+    assert by_name["baseline"]["face_one_percent_head_m"] == pytest.approx(0.050) and by_name["kwlow"]["face_one_percent_head_m"] is None
     lines = pile_tradeoffs.table(rows, "test machine")
     header = [c.strip() for c in lines[2].split("|")]
     baseline = [c.strip() for c in next(l for l in lines if l.startswith("| baseline |")).split("|")]
