@@ -1007,21 +1007,39 @@ namespace stages {
 				});
 				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 				const Real V = P.volume[p];
-				std::array<int, 3> at[S * S * S];
-				for (int a = 0; a < m; ++a) at[a] = grid.indices(I[a]);
+				// each node's place in the 5³ box of offsets, relative to the first node: a pair's slot is
+				// centreSlot + place[b] − place[a] while the stencil spans at most 3 nodes per axis (a
+				// periodic wrap, refused at setup, would not: such a pair is skipped)
+				const std::array<int, 3> first = grid.indices(I[0]);
+				int                      place[S * S * S], low[3] = { 0, 0, 0 }, high[3] = { 0, 0, 0 };
+				for (int a = 0; a < m; ++a) {
+					const std::array<int, 3> at = grid.indices(I[a]);
+					int                      d3[3];
+					for (int d = 0; d < 3; ++d) d3[d] = at[d] - first[d], low[d] = std::min(low[d], d3[d]), high[d] = std::max(high[d], d3[d]);
+					place[a] = d3[0] + 5 * d3[1] + 25 * d3[2];
+				}
+				const bool compact = high[0] - low[0] <= 2 && high[1] - low[1] <= 2 && high[2] - low[2] <= 2;
+				if (!compact) continue;
+				// the point's terms, V S_J and V ∇S_J, as plain arrays: the pair loop below is the stage's hot loop
+				Real VdN[3][S * S * S];
+				for (int b = 0; b < m; ++b)
+					for (int d = 0; d < 3; ++d) VdN[d][b] = V * dN[b][d];
 				for (int a = 0; a < m; ++a) {
 					if (slotOf[I[a]] < 0) continue;
-					auto& c = mine[static_cast<std::size_t>(slotOf[I[a]])];
-					myShare[static_cast<std::size_t>(slotOf[I[a]])] += V * N[a];
-					const std::array<int, 3>& ia = at[a];
+					Coupling*  c    = mine[static_cast<std::size_t>(slotOf[I[a]])].data() + (centreSlot - place[a]);
+					const Real Na   = N[a];
+					const Real NaS  = (1 - n) * Na, NaW = n * Na;
+					const Real Da[3] = { VdN[0][a], VdN[1][a], VdN[2][a] };
+					myShare[static_cast<std::size_t>(slotOf[I[a]])] += V * Na;
 					for (int b = 0; b < m; ++b) {
-						const std::array<int, 3>& ib = at[b];
-						const int dx = ib[0] - ia[0], dy = ib[1] - ia[1], dz = ib[2] - ia[2];
-						if (std::abs(dx) > 2 || std::abs(dy) > 2 || std::abs(dz) > 2) continue; // a periodic wrap (refused at setup)
-						Coupling& e = c[offsetSlot(dx, dy, dz)];
-						e.surface += V * (N[b] * dN[a] + N[a] * dN[b]);
-						e.solid -= V * (1 - n) * N[a] * dN[b];
-						e.water -= V * n * N[a] * dN[b];
+						// Σ_IJ += V ∇(S_I S_J), g^s_IJ −= V (1 − n) S_I ∇S_J, g^w_IJ −= V n S_I ∇S_J (eq. 8.5e)
+						Coupling& e = c[place[b]];
+						for (int d = 0; d < 3; ++d) {
+							const Real g = VdN[d][b];
+							e.surface[d] += N[b] * Da[d] + Na * g;
+							e.solid[d] -= NaS * g;
+							e.water[d] -= NaW * g;
+						}
 					}
 				}
 			}
@@ -1088,24 +1106,22 @@ namespace stages {
 				for (int e = 0; e < 3; ++e)
 					for (int f = 0; f < 3; ++f) Z[d][e][f] = zd[e][f];
 			}
-			alignas(64) Real value[125];
 			for (int x = 0; x < m; ++x) {
 				Real zu[9];
 				for (int d = 0; d < 3; ++d)
 					for (int e = 0; e < 3; ++e) zu[3 * d + e] = Z[d][e][0] * u[3 * d][x] + Z[d][e][1] * u[3 * d + 1][x] + Z[d][e][2] * u[3 * d + 2][x];
-				for (int y = x; y < m; ++y) value[y] = 0;
-				for (int e = 0; e < 9; ++e) {
-					const Real  z   = zu[e];
-					const Real* col = u[e];
-					for (int y = x; y < m; ++y) value[y] += col[y] * z;
-				}
 				const int a = rowOf[x];
 				if (blockOf[a] < 0) {
 					blockOf[a] = static_cast<int>(used++);
 					if (blocks.size() < used * blockSlots) blocks.resize(used * blockSlots, 0); // kept zero between steps: grown only
 				}
 				Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots - code[x];
-				for (int y = x; y < m; ++y) block[code[y]] += value[y]; // code[y] ≥ code[x]: offset order
+				// one pass per pair: its nine terms summed in registers, then added to the row's block
+				for (int y = x; y < m; ++y) {
+					Real value = 0;
+					for (int e = 0; e < 9; ++e) value += u[e][y] * zu[e];
+					block[code[y]] += value; // code[y] ≥ code[x]: offset order
+				}
 			}
 		};
 		// the candidates split among the threads, each summing into its own blocks; then summed in thread order
