@@ -92,6 +92,11 @@ class Section:
         return np.interp(x, self.surface_x, self.surface_z)
 
 
+def _clamp(values, low, high):
+    """np.clip(values, low, high) by two ufuncs: the same numbers, without np.clip's argument checks,
+    which cost several times the arithmetic on the short arrays of a circle search's inner loop."""
+    return np.minimum(np.maximum(values, low), high)
+
 def uniform_section(surface_x, surface_z, unit_weight, strength, pore_pressure=None, direction=1, base_z=None):
     """A section of one material of unit weight γ [N m⁻³] (> 0); pore_pressure(x, z) [Pa] or None (dry)."""
     if not unit_weight > 0:
@@ -100,7 +105,7 @@ def uniform_section(surface_x, surface_z, unit_weight, strength, pore_pressure=N
     surface_z = np.asarray(surface_z, dtype=float)
 
     def column_weight(x, z_base):
-        return unit_weight * np.clip(np.interp(x, surface_x, surface_z) - z_base, 0, None)
+        return unit_weight * np.maximum(np.interp(x, surface_x, surface_z) - z_base, 0)
 
     dry = lambda x, z: np.zeros(np.broadcast(x, z).shape)
     return Section(surface_x, surface_z, column_weight, pore_pressure or dry, strength, direction, base_z).validate()
@@ -149,7 +154,7 @@ def slices_of_circle(section, centre, radius, count=40, min_depth=0.0, free_grou
     x = np.linspace(x_lo, x_hi, 801)
 
     def base(xq):
-        zb = zc - np.sqrt(np.clip(radius * radius - (xq - xc) ** 2, 0, None))
+        zb = zc - np.sqrt(np.maximum(radius * radius - (xq - xc) ** 2, 0))
         return zb if section.base_z is None else np.maximum(zb, section.base_z)
 
     depth = section.surface(x) - base(x)
@@ -217,19 +222,20 @@ def bishop_simplified(slices, tolerance=1e-8, max_iterations=200):
     c, t = slices.cohesion, slices.tan_friction
     l = slices.base_length
     rx, rz = slices.x - xc, slices.z - zc
-    shear_arm = -(rx * np.sin(a) + rz * np.cos(a))   # R on a circle
-    normal_arm = rx * np.cos(a) - rz * np.sin(a)     # 0 on a circle
+    cos_a, sin_a = np.cos(a), np.sin(a)
+    shear_arm = -(rx * sin_a + rz * cos_a)   # R on a circle
+    normal_arm = rx * cos_a - rz * sin_a     # 0 on a circle
     driving = -np.sum(W * rx)
     if driving <= 0:
         return math.inf
     F = 1.0
     for _ in range(max_iterations):
-        m_alpha = np.cos(a) + np.sin(a) * t / F
+        m_alpha = cos_a + sin_a * t / F
         if np.any(m_alpha < 0.2):
             # m_α < 0.2 at a steep exit: the normal force there is unreliable and the method is known
             # to fail (Whitman & Bailey 1967, who recommend discarding such surfaces): no admissible F
             return math.nan
-        N_eff = (W - u * b - c * l * np.sin(a) / F) / m_alpha
+        N_eff = (W - u * b - c * l * sin_a / F) / m_alpha
         resisting = np.sum((c * l + N_eff * t) * shear_arm)
         F_new = resisting / (driving + np.sum((N_eff + u * l) * normal_arm))
         if not (np.isfinite(F_new) and F_new > 0):
@@ -456,14 +462,14 @@ def section_from_points(solid_positions, solid_masses, water_positions, water_ma
 
     def column_weight_of(cols, z_base):
         # weight above z_base [Pa] in the bin columns cols: the bins above in full, the cut one in part
-        kk = np.clip(np.floor((z_base - z0) / bin_size).astype(int), 0, nz - 1)
-        frac = np.clip((z_edges[kk + 1] - z_base) / bin_size, 0, 1)
+        kk = _clamp(np.floor((z_base - z0) / bin_size).astype(int), 0, nz - 1)
+        frac = _clamp((z_edges[kk + 1] - z_base) / bin_size, 0, 1)
         upper = np.where(kk + 1 < nz, above[cols, np.minimum(kk + 1, nz - 1)], 0.0)
         return upper + frac * gamma[cols, kk] * bin_size
 
     def column_weight(x, z_base):
         x, z_base = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(z_base, dtype=float))
-        fx = np.clip((x - centres_x[0]) / bin_size, 0, nx - 1 - 1e-9)
+        fx = _clamp((x - centres_x[0]) / bin_size, 0, nx - 1 - 1e-9)
         i0 = fx.astype(int)
         tx = fx - i0
         return (1 - tx) * column_weight_of(i0, z_base) + tx * column_weight_of(np.minimum(i0 + 1, nx - 1), z_base)
@@ -480,8 +486,8 @@ def section_from_points(solid_positions, solid_masses, water_positions, water_ma
 
     def pore_pressure(x, z):
         x, z = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(z, dtype=float))
-        fx = np.clip((x - centres_x[0]) / bin_size, 0, nx - 1 - 1e-9)
-        fz = np.clip((z - centres_z[0]) / bin_size, 0, nz - 1 - 1e-9)
+        fx = _clamp((x - centres_x[0]) / bin_size, 0, nx - 1 - 1e-9)
+        fz = _clamp((z - centres_z[0]) / bin_size, 0, nz - 1 - 1e-9)
         i0, k0 = fx.astype(int), fz.astype(int)
         i1, k1 = np.minimum(i0 + 1, nx - 1), np.minimum(k0 + 1, nz - 1)
         tx, tz = fx - i0, fz - k0
