@@ -426,14 +426,18 @@ sliding_at_failure = band_base(failure_kappa) if failure is not None else None
 
 # --- limit equilibrium: the head at which Bishop's factor of safety first falls below 1 -----------
 def lem_crossing(which):
-    """Where the factor of the circles `which` (2: shallowest, 3: deep, 4: deep at the peak strength) first falls below 1, linear
-    between two evaluations; None if it never does."""
-    for r0, r1 in zip(lem_records, lem_records[1:]):
-        (t0, h0), (t1, h1), c0, c1 = r0[:2], r1[:2], r0[which], r1[which]
-        if c0 is not None and c1 is not None and c0.factor >= 1 > c1.factor:
-            w = (c0.factor - 1) / (c0.factor - c1.factor)
-            return {"time_s": t0 + w * (t1 - t0), "head_m": h0 + w * (h1 - h0), "centre_m": list(c1.centre), "radius_m": c1.radius}
-    return None
+    """Where the factor of the circles `which` (2: shallowest, 3: deep, 4: deep at the peak strength) first lies below 1
+    (yade_mpm.analysis.falls_below: linear between two evaluations, or the first evaluation if the pile starts short of
+    equilibrium; a later fall after the reshaped slope's factor rose again is not its onset), with the critical circle
+    of the evaluation at or after it; None if it never does."""
+    evaluated = [r for r in lem_records if r[which] is not None]
+    times = [r[0] for r in evaluated]
+    crossing = yade_mpm.analysis.falls_below(times, [r[which].factor for r in evaluated])
+    if crossing is None:
+        return None
+    circle = next((r[which] for r in evaluated if r[0] >= crossing), evaluated[-1][which])
+    return {"time_s": crossing, "head_m": float(np.interp(crossing, times, [r[1] for r in evaluated])), "centre_m": list(circle.centre),
+            "radius_m": circle.radius}
 
 
 lem_onset, lem_deep_onset, lem_deep_peak_onset = lem_crossing(2), lem_crossing(3), lem_crossing(4)
