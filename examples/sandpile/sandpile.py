@@ -15,8 +15,9 @@ that keeps the capillary suction above the phreatic line and is a seepage face (
 none in) below it, and water that seeps out of the pile is taken by the filtering cloth
 (removed once it has left the soil, its mass counted). Mohr–Coulomb sand with friction softening.
 
-Quick mode: cell h = 2 cm (6 cells over the pile height), 7-9 min on 2 cores. Full mode:
-h = 1 cm (about 16 times the cost). Both run the whole head history. --sand-from-dem DIR takes the sand from a DEM + PFV pile
+Quick mode: cell h = 2 cm (6 cells over the pile height), 8 min on 2 cores. Full mode:
+h = 1 cm (about 16 times the cost: 68 min on one thread with --inertia-release inf). Both run the whole head
+history. --sand-from-dem DIR takes the sand from a DEM + PFV pile
 run (examples/dem/sandpile.py --out DIR: strength from the drained triaxial test on its grains,
 stiffness, porosity and permeability from the oedometer and flow test on them).
 
@@ -63,7 +64,7 @@ from yade import O
 from yade_mpm import MpmHdf5Recorder, MpmSoilMat, MpmTwoPhaseEngine, MpmWaterMat, calibrate, sandpile
 
 parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-parser.add_argument("--quick", action="store_true", help="2 cm cells: 7-9 min on 2 cores (the CI test runs this with a 20 s rise)")
+parser.add_argument("--quick", action="store_true", help="2 cm cells: 8 min on 2 cores (the CI test runs this with a 20 s rise)")
 parser.add_argument("--cell", type=float, help="cell size h [m] (default 0.02 quick, 0.01 full)")
 parser.add_argument("--duration", type=float, help="stop after this time [s] (default: the whole head history)")
 parser.add_argument("--out", help="output directory")
