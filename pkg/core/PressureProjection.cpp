@@ -1008,8 +1008,9 @@ namespace stages {
 				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 				const Real V = P.volume[p];
 				// each node's place in the 5³ box of offsets, relative to the first node: a pair's slot is
-				// centreSlot + place[b] − place[a] while the stencil spans at most 3 nodes per axis (a
-				// periodic wrap, refused at setup, would not: such a pair is skipped)
+				// centreSlot + place[b] − place[a] while the stencil spans at most 3 nodes per axis; one
+				// wrapped across a periodic axis would not (the capillary surface refuses periodic axes at
+				// setup, TwoPhaseSolver), and such a point is skipped
 				const std::array<int, 3> first = grid.indices(I[0]);
 				int                      place[S * S * S], low[3] = { 0, 0, 0 }, high[3] = { 0, 0, 0 };
 				for (int a = 0; a < m; ++a) {
