@@ -97,6 +97,7 @@ def _clamp(values, low, high):
     which cost several times the arithmetic on the short arrays of a circle search's inner loop."""
     return np.minimum(np.maximum(values, low), high)
 
+
 def uniform_section(surface_x, surface_z, unit_weight, strength, pore_pressure=None, direction=1, base_z=None):
     """A section of one material of unit weight γ [N m⁻³] (> 0); pore_pressure(x, z) [Pa] or None (dry)."""
     if not unit_weight > 0:
