@@ -62,7 +62,8 @@ class Section:
     """A 2D slope section.
 
     surface_x, surface_z: the ground surface as a polyline, x increasing [m];
-    column_weight(x, z_base): weight of the column above z_base at x per unit area, ∫ γ dz [Pa];
+    column_weight(x, z_base): weight of the column above z_base at x per unit area, ∫ γ dz [Pa], point by
+        point over numpy arrays;
     pore_pressure(x, z): u [Pa] (compression-positive), vectorised over numpy arrays;
     strength: the Strength used on the slip surface (apply .davis() before for non-associated flow);
     direction: +1 where the slope descends towards +x, −1 towards −x;
@@ -147,42 +148,59 @@ def slices_of_circle(section, centre, radius, count=40, min_depth=0.0, free_grou
     (clipped by section.base_z), or None where it does not cut a sliding mass deeper than
     min_depth [m], leaves the section's ends, or breaks through the ground outside free_ground
     ((x_lo, x_hi) [m], section frame; None: anywhere)."""
+    return _slices_of_circles(section, centre, np.array([radius], dtype=float), count, min_depth, free_ground)[0]
+
+
+def _circle_base(section, centre, radius):
+    """The slip surface z(x) of a circle: its lower arc, clipped by section.base_z."""
     xc, zc = centre
-    x_lo = max(xc - radius, section.surface_x[0])
-    x_hi = min(xc + radius, section.surface_x[-1])
-    if x_hi <= x_lo:
-        return None
-    x = np.linspace(x_lo, x_hi, 801)
 
     def base(xq):
         zb = zc - np.sqrt(np.maximum(radius * radius - (xq - xc) ** 2, 0))
         return zb if section.base_z is None else np.maximum(zb, section.base_z)
+    return base
 
-    depth = section.surface(x) - base(x)
-    inside = depth > 0
-    if not inside.any():
-        return None
-    # the contiguous run that holds the deepest point is the sliding mass
-    deepest = int(np.argmax(depth))
-    lo = deepest
-    while lo > 0 and inside[lo - 1]:
-        lo -= 1
-    hi = deepest
-    while hi < x.size - 1 and inside[hi + 1]:
-        hi += 1
-    if depth[deepest] < min_depth:
-        return None
-    if lo == 0 or hi == x.size - 1:
-        # the lower arc ends under the ground (the circle's side, or the section's end): not a
-        # slip surface from ground to ground
-        return None
-    # entry and exit where the depth crosses zero (linear between samples)
-    x_in = x[lo - 1] + (x[lo] - x[lo - 1]) * (-depth[lo - 1]) / (depth[lo] - depth[lo - 1])
-    x_out = x[hi] + (x[hi + 1] - x[hi]) * depth[hi] / (depth[hi] - depth[hi + 1])
-    if free_ground is not None and not (free_ground[0] <= x_in and x_out <= free_ground[1]):
-        return None
-    edges = np.linspace(x_in, x_out, count + 1)
-    return _build_slices(section, edges, base, (xc, zc))
+
+def _slices_of_circles(section, centre, radii, count, min_depth, free_ground):
+    """slices_of_circle for each of the radii about one centre, as a list: the 801 samples of every
+    circle in one array (a search evaluates thousands of circles, most rejected, and the cost of one
+    alone is numpy's overhead per call); the same operations per sample, so the same numbers."""
+    section.validate()
+    xc, zc = centre
+    found = [None] * radii.size
+    x_lo = np.maximum(xc - radii, section.surface_x[0])
+    x_hi = np.minimum(xc + radii, section.surface_x[-1])
+    spanning = np.flatnonzero(x_hi > x_lo)
+    if spanning.size == 0:
+        return found
+    x = np.linspace(x_lo[spanning], x_hi[spanning], 801, axis=1)
+    depth = section.surface(x) - _circle_base(section, centre, radii[spanning, None])(x)
+    deepest_of = np.argmax(depth, axis=1)
+    for row, k in enumerate(spanning):
+        deepest = int(deepest_of[row])
+        # nothing below the ground, or the sliding mass thinner than min_depth
+        if not depth[row, deepest] > 0 or depth[row, deepest] < min_depth:
+            continue
+        # the contiguous run that holds the deepest point is the sliding mass: from after the last
+        # sample outside before it to before the first outside after it
+        inside = depth[row] > 0
+        outside_before = np.flatnonzero(~inside[:deepest])
+        lo = int(outside_before[-1]) + 1 if outside_before.size else 0
+        outside_after = np.flatnonzero(~inside[deepest + 1:])
+        hi = deepest + int(outside_after[0]) if outside_after.size else x.shape[1] - 1
+        if lo == 0 or hi == x.shape[1] - 1:
+            # the lower arc ends under the ground (the circle's side, or the section's end): not a
+            # slip surface from ground to ground
+            continue
+        # entry and exit where the depth crosses zero (linear between samples)
+        xs, ds = x[row], depth[row]
+        x_in = xs[lo - 1] + (xs[lo] - xs[lo - 1]) * (-ds[lo - 1]) / (ds[lo] - ds[lo - 1])
+        x_out = xs[hi] + (xs[hi + 1] - xs[hi]) * ds[hi] / (ds[hi] - ds[hi + 1])
+        if free_ground is not None and not (free_ground[0] <= x_in and x_out <= free_ground[1]):
+            continue
+        edges = np.linspace(x_in, x_out, count + 1)
+        found[k] = _build_slices(section, edges, _circle_base(section, centre, radii[k]), (xc, zc))
+    return found
 
 
 def _build_slices(section, edges, base, centre):
@@ -191,12 +209,13 @@ def _build_slices(section, edges, base, centre):
     mid = 0.5 * (edges[:-1] + edges[1:])
     width = np.diff(edges)
     z_mid = base(mid)
+    z_edges = base(edges)  # base and column_weight act point by point: once on all edges, then each side
     # weight by Simpson's rule over each slice (exact for a linear surface and a straight base)
-    w_lo = section.column_weight(edges[:-1], base(edges[:-1]))
-    w_hi = section.column_weight(edges[1:], base(edges[1:]))
+    w_edges = section.column_weight(edges, z_edges)
+    w_lo, w_hi = w_edges[:-1], w_edges[1:]
     w_mid = section.column_weight(mid, z_mid)
     weight = width * (w_lo + 4 * w_mid + w_hi) / 6
-    slope = (base(edges[1:]) - base(edges[:-1])) / width
+    slope = (z_edges[1:] - z_edges[:-1]) / width
     u = np.asarray(section.pore_pressure(mid, z_mid), dtype=float)
     s = section.direction
     strength = section.strength
@@ -229,16 +248,20 @@ def bishop_simplified(slices, tolerance=1e-8, max_iterations=200):
     driving = -np.sum(W * rx)
     if driving <= 0:
         return math.inf
+    # the iteration's terms that do not depend on F, formed once (the same numbers: each as the left-to-right
+    # products and differences of the formulas); ndarray methods, not np.* wrappers: the arrays are short
+    sin_tan, effective_weight, cohesion_force = sin_a * t, W - u * b, c * l
+    cohesion_lift, water_force = cohesion_force * sin_a, u * l
     F = 1.0
     for _ in range(max_iterations):
-        m_alpha = cos_a + sin_a * t / F
-        if np.any(m_alpha < 0.2):
+        m_alpha = cos_a + sin_tan / F
+        if (m_alpha < 0.2).any():
             # m_α < 0.2 at a steep exit: the normal force there is unreliable and the method is known
             # to fail (Whitman & Bailey 1967, who recommend discarding such surfaces): no admissible F
             return math.nan
-        N_eff = (W - u * b - c * l * sin_a / F) / m_alpha
-        resisting = np.sum((c * l + N_eff * t) * shear_arm)
-        F_new = resisting / (driving + np.sum((N_eff + u * l) * normal_arm))
+        N_eff = (effective_weight - cohesion_lift / F) / m_alpha
+        resisting = ((cohesion_force + N_eff * t) * shear_arm).sum()
+        F_new = resisting / (driving + ((N_eff + water_force) * normal_arm).sum())
         if not (np.isfinite(F_new) and F_new > 0):
             return math.nan  # the base's normal forces outweigh the driving moment: no admissible F
         if abs(F_new - F) <= tolerance * abs(F):
@@ -385,8 +408,8 @@ def critical_circle(section, centres_x, centres_z, radii_per_centre=12, min_dept
                     continue
                 radii = np.concatenate([np.linspace(r_min, r_max, radii_per_centre + 1)[1:],
                                         np.hypot(corner_x - xc, corner_z - zc) * (1 + 1e-9)])
-                for radius in radii[(radii > r_min) & (radii <= r_max)]:
-                    slices = slices_of_circle(section, (xc, zc), radius, slice_count, min_depth, free_ground)
+                radii = radii[(radii > r_min) & (radii <= r_max)]
+                for radius, slices in zip(radii, _slices_of_circles(section, (xc, zc), radii, slice_count, min_depth, free_ground)):
                     if slices is None:
                         continue
                     searched += 1
