@@ -38,7 +38,10 @@ Writes to DIR (default examples/sandpile/out[-quick]):
                                   limit-equilibrium onset heads (lem_onset_head_m; lem_deep_onset_head_m
                                   for slides ≥ 3 cells deep; lem_deep_peak_onset_head_m for the same at
                                   the sand's peak strength, without Davis), water balance
-                                  (injected_kg, removed_kg, relative_residual), run time
+                                  (injected_kg, removed_kg, relative_residual), run time, and when
+                                  the head first stood above the ground at the inflow face
+                                  (inflow_overtopped: the reservoir would spill over the crest, which
+                                  the model does not represent; time series column ground_at_inflow_m)
 The water mass balance (initial + injected = stored + removed) is checked at every record; the run
 stops with an error if it fails to close to 1e-9. If the solver stops the run as unstable (a point
 moving more than a cell in a step, or a pressure solve that does not converge), everything is still
@@ -297,6 +300,17 @@ def toe_displacement():
     return float((solid.pos[toe_points, 0] - start_positions[toe_points, 0]).mean())
 
 
+inflow_column = np.flatnonzero(start_positions[:, 0] < CELL)  # the solid points of the first cell's column at the inflow face
+
+
+def ground_at_inflow():
+    """Ground height [m] at the inflow face: the top of the first cell's column of solid points (their
+    domain's upper edge). Where the head stands above it the reservoir would spill over the crest, which
+    the model does not represent (free water above the soil leaves through the filtering cloth, the ground
+    next to the face stays a drained surface, p = 0)."""
+    return float(solid.pos[inflow_column, 2].max() + 0.5 * spacing)
+
+
 def face_displacement():
     """Mean displacement magnitude [m] of the lower slope face's solid points."""
     return float(np.linalg.norm(solid.pos[face_points] - start_positions[face_points], axis=1).mean())
@@ -365,7 +379,7 @@ while O.time < DURATION - 0.5 * O.dt:  # O.time sums O.dt: thousands of round-of
            "max_solid_speed_m_per_s": float(speed.max()), "water_points": fluid.count, "injected_kg": engine.injectedWaterMass,
            "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual, "inertia_scale": engine.inertiaScale,
            "inertia_ratio": engine.inertiaRatio,
-           "kinetic_energy_J": yade_mpm.analysis.kinetic_energy(solid.mass, solid.vel)}
+           "kinetic_energy_J": yade_mpm.analysis.kinetic_energy(solid.mass, solid.vel), "ground_at_inflow_m": ground_at_inflow()}
     row.update({"p_%s_Pa" % name.replace(" ", "_"): probe_pressure(loc) for name, loc in PROBES.items()})  # e.g. p_upstream_x=0.05_Pa
     # Bishop's factor of safety on the run's own pressure field, at every HDF5 frame (about 1 s each)
     row["lem_factor_of_safety"] = float("nan")
@@ -470,6 +484,14 @@ kinetic = None if kinetic_index is None else {"time_s": float(times[kinetic_inde
 first_zone = None
 if onset_index is not None and settled is not None:
     first_zone = yade_mpm.analysis.mobilised_zone(rise_start_positions, record_positions[onset_index])
+overtopped = None
+if not SUBMERGED:
+    # the margin of the ground over the head falls below 0: read at the time and at the head
+    margin = [r["ground_at_inflow_m"] - r["head_m"] for r in rows]
+    t_over = yade_mpm.analysis.falls_below([r["time_s"] for r in rows], margin, level=0.0)
+    if t_over is not None:
+        overtopped = {"time_s": t_over, "head_m": SCENE.head(t_over),  # and how far the toe had moved by then [m]
+                      "toe_displacement_m": float(np.interp(t_over, [r["time_s"] for r in rows], [r["toe_displacement_m"] for r in rows]))}
 runout = yade_mpm.analysis.toe_runout(start_positions, solid.pos, toe_x=float(start_positions[:, 0].max()), base_band=2 * CELL)
 deposit_x, deposit_z = yade_mpm.analysis.deposit_profile(solid.pos, PROFILE_BINS, half_height=0.5 * spacing)
 deposit_slope = yade_mpm.analysis.deposit_slope_angle(deposit_x, deposit_z, from_x=SCENE.crest_length, min_height=spacing)
@@ -522,6 +544,10 @@ summary = {
     "lem_deep_onset_head_m": lem_summary["lem_deep_onset_head_m"],
     "lem_deep_peak_onset_head_m": lem_summary["lem_deep_peak_onset_head_m"],
     "runout_m": runout,
+    # when the head first stood above the ground at the inflow face (the crest subsided by the slide): from then
+    # on the laboratory reservoir would spill over the crest, which the model does not represent (None: never;
+    # also for a submerged pile, whose still water above the ground is part of the model, eq. 1.9)
+    "inflow_overtopped": overtopped,
     "mobilised_volume_m3": mobilised,
     "mobilised_fraction": mobilised_fraction,
     "deposit_profile": {"x_m": deposit_x.tolist(), "z_m": [None if np.isnan(z) else float(z) for z in deposit_z]},
@@ -582,4 +608,4 @@ yade_mpm.plotting.time_series(os.path.join(OUT, "time_series.png"), {key: [r[key
 print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "stopped_unstable", "failure", "sliding_surface", "sliding_surface_at_failure", "water_mass_balance",
                                           "stable_before_rise")}, indent=2))
 print(json.dumps({k: lem_summary[k] for k in ("lem_onset_head_m", "factors", "lem_deep_onset_head_m", "deep_factors", "lem_deep_peak_onset_head_m", "deep_peak_factors")}))
-print(json.dumps({k: summary[k] for k in ("onset", "kinetic_onset", "runout_m", "mobilised_fraction")}))
+print(json.dumps({k: summary[k] for k in ("onset", "kinetic_onset", "runout_m", "mobilised_fraction", "inflow_overtopped")}))

@@ -245,6 +245,29 @@ def test_summary_reports_onset_runout_and_water_that_really_flowed(quick_run):
         assert zone["count"] == round(0.1 * summary["points_per_phase_initial"])
 
 
+def test_the_head_passing_the_ground_at_the_inflow_face_is_recorded(quick_run):
+    """From the time the head first stands above the ground at the inflow face (the crest subsided by
+    the slide) the laboratory reservoir would spill over the crest, which the model does not represent
+    (doc/sandpile.md, Full mode): summary.json's inflow_overtopped must be that time. The ground there
+    starts at the pile's height (the first cell's column, its points' domain edge: settlement only, µm);
+    every record before the reported time has the ground at or above the head, the first record after it
+    below (the time lies between them, linear); its head is the history's head at that time; none where
+    the ground stays above the head throughout."""
+    _, summary, rows = quick_run
+    scene = summary["scene"]
+    assert rows[0]["ground_at_inflow_m"] == pytest.approx(scene["pile_height"], abs=1e-4)
+    margin = [(r["time_s"], r["ground_at_inflow_m"] - r["head_m"]) for r in rows]
+    over = summary["inflow_overtopped"]
+    if over is None:
+        assert all(m >= 0 for _, m in margin)
+        return
+    assert all(m >= 0 for t, m in margin if t < over["time_s"])
+    after = [m for t, m in margin if t >= over["time_s"]]
+    assert after and after[0] < 0
+    rise = min(max((over["time_s"] - scene["settle_time"]) / scene["head_ramp_time"], 0), 1)
+    assert over["head_m"] == pytest.approx(scene["head_start"] + rise * (scene["head_end"] - scene["head_start"]), rel=1e-9)
+
+
 def _example(out, *arguments):
     """Runs examples/sandpile/sandpile.py with `arguments`, writing to `out`, on one thread."""
     return subprocess.run(["yade-double", "-j1", "-n", "-x", str(pathlib.Path(__file__).parents[2] / "examples" / "sandpile" / "sandpile.py"),
