@@ -8,7 +8,9 @@
 #include "support/Fixtures.hpp"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -181,65 +183,90 @@ TEST(PressureSystem, ANonFiniteEntryStopsTheBuildWithItsPlace)
 // of K and factors the pair terms by axis (issue 18); its CSR matrix must equal this sum to
 // round-off, with the prescribed columns moved to the right-hand side: b_I − Σ_J K_IJ p̄_J. On a
 // periodic axis of 3 cells two stencil offsets reach one node, and their entries must add up.
+// A saturated box of random solid and water points (GIMP), mapped to the grid, its pressure nodes
+// classified and its system assembled (impermeable walls, a drained top at p̄ = 750 Pa, some nodes held
+// along one axis by walls): the scene the pressure system's definition tests read.
+struct RandomPressureScene {
+	static constexpr Real h = 0.1, dt = 1e-3;
+	GridGeometry                     grid;
+	GridFields                       fields;
+	std::mt19937_64                  rng { 11 };
+	std::uniform_real_distribution<Real> unit { -1, 1 };
+	SolidPointSet                    solid;
+	WaterPointSet                    fluid;
+	SoilParameters                   soil;
+	WaterParameters                  water;
+	std::vector<SolidSet>            solids;
+	std::vector<WaterPointSet*>      waters;
+	ConstrainedNodes                 held;
+	std::vector<std::array<bool, 3>> heldSolid;
+	PressureSystem                   system;
+
+	explicit RandomPressureScene(bool periodicX)
+	    : grid(GridGeometry::forDomain(Vec3::Zero(), Vec3(0.3, 0.3, 0.4), h, { periodicX, false, false }))
+	{
+		fields.resize(grid.nodeCount());
+		// the predicted velocities the right-hand side reads (the predictor's, not run here): at rest
+		std::fill(fields.solidVelocityNew.begin(), fields.solidVelocityNew.end(), Vec3::Zero());
+		std::fill(fields.waterVelocityNew.begin(), fields.waterVelocityNew.end(), Vec3::Zero());
+		std::uniform_real_distribution<Real> ux(periodicX ? 0.0 : 0.03, periodicX ? 0.3 : 0.27), uy(0.03, 0.27), uz(0.03, 0.33), len(0.015, 0.025);
+		solid.resize(400);
+		fluid.resize(400);
+		for (std::size_t p = 0; p < solid.size(); ++p) {
+			solid.position[p]   = Vec3(ux(rng), uy(rng), uz(rng));
+			solid.mass[p]       = 2650 * 0.6 * 1.2e-4 * (1 + 0.2 * unit(rng));
+			solid.volume[p]     = solid.initialVolume[p] = 1.2e-4;
+			solid.halfLength[p] = solid.initialHalfLength[p] = Vec3(len(rng), len(rng), len(rng));
+			solid.porosity[p]   = 0.4;
+			fluid.position[p]   = Vec3(ux(rng), uy(rng), uz(rng));
+			fluid.mass[p]       = 1000 * 0.4 * 1.2e-4;
+			fluid.volume[p]     = 1.2e-4 * (1 + 0.3 * unit(rng));
+			fluid.halfLength[p] = Vec3(len(rng), len(rng), len(rng));
+			fluid.porePressure[p] = 1e3 * unit(rng);
+			fluid.porosity[p]     = 0.4;
+		}
+		water.bulkModulus = 2.2e7; // a storage term of the size of the conductance
+		BoundaryConditions bcs;
+		bcs.periodic                                    = { periodicX, false, false };
+		for (int f = periodicX ? 2 : 0; f < faceCount; ++f) bcs.walls[f].water = WaterWall::Impermeable;
+		bcs.walls[static_cast<int>(Face::ZMax)].water   = WaterWall::Drained;
+		bcs.walls[static_cast<int>(Face::ZMax)].drainedPressure = 750;
+		solids = { SolidSet { &solid, soil } };
+		waters = { &fluid };
+		ScatterWorkspace ws;
+		stages::resetGrid(fields);
+		stages::mapSolidToGrid<GimpKernel>(grid, solids, &water, Vec3::Zero(), fields, ws);
+		stages::computeNodalPorosity(fields);
+		stages::mapWaterToGrid<GimpKernel>(grid, waters, Vec3::Zero(), fields, ws);
+		stages::classifyPressureNodes<GimpKernel>(grid, fields, waters, bcs, Vec3::Zero(), water.density, system);
+		// walls holding a phase along one axis at some nodes make λ differ between the axes (eq. 8.5 with holds)
+		for (std::size_t I = 0; I < grid.nodeCount(); I += 3) {
+			NodeConstraint constraint;
+			constraint.water[1] = I % 2 == 0;
+			held.node.push_back(I);
+			held.constraint.push_back(constraint);
+			heldSolid.push_back({ I % 2 == 1, false, I % 4 == 1 });
+		}
+		held.positionOf.assign(grid.nodeCount(), -1); // as ConstrainedNodes::build leaves it
+		for (std::size_t c = 0; c < held.node.size(); ++c) held.positionOf[held.node[c]] = static_cast<int>(c);
+		stages::assemblePressureSystem<GimpKernel>(grid, fields, solids, waters, water, held, heldSolid, dt, 1e-12, 1e-12, system);
+	}
+};
+
 // With extra pairs (the capillary surface's terms, eq. 8.5f: PressureSystem::extraPairs, one entry per
 // unordered pair, some on a stored pair's column, some up to 4 cells apart, given out of order), each
 // adds its value to K_IJ and K_JI and the matrix must still be that sum.
 void expectMatrixIsThePairSum(bool periodicX, bool extraPairs = false)
 {
-	const Real         h = 0.1, dt = 1e-3;
-	const GridGeometry grid = GridGeometry::forDomain(Vec3::Zero(), Vec3(0.3, 0.3, 0.4), h, { periodicX, false, false });
-	GridFields         fields;
-	fields.resize(grid.nodeCount());
-	// the predicted velocities the right-hand side reads (the predictor's, not run here): at rest
-	std::fill(fields.solidVelocityNew.begin(), fields.solidVelocityNew.end(), Vec3::Zero());
-	std::fill(fields.waterVelocityNew.begin(), fields.waterVelocityNew.end(), Vec3::Zero());
-	std::mt19937_64                      rng(11);
-	std::uniform_real_distribution<Real> ux(periodicX ? 0.0 : 0.03, periodicX ? 0.3 : 0.27), uy(0.03, 0.27), uz(0.03, 0.33), unit(-1, 1), len(0.015, 0.025);
-	SolidPointSet                        solid;
-	WaterPointSet                        fluid;
-	solid.resize(400);
-	fluid.resize(400);
-	for (std::size_t p = 0; p < solid.size(); ++p) {
-		solid.position[p]   = Vec3(ux(rng), uy(rng), uz(rng));
-		solid.mass[p]       = 2650 * 0.6 * 1.2e-4 * (1 + 0.2 * unit(rng));
-		solid.volume[p]     = solid.initialVolume[p] = 1.2e-4;
-		solid.halfLength[p] = solid.initialHalfLength[p] = Vec3(len(rng), len(rng), len(rng));
-		solid.porosity[p]   = 0.4;
-		fluid.position[p]   = Vec3(ux(rng), uy(rng), uz(rng));
-		fluid.mass[p]       = 1000 * 0.4 * 1.2e-4;
-		fluid.volume[p]     = 1.2e-4 * (1 + 0.3 * unit(rng));
-		fluid.halfLength[p] = Vec3(len(rng), len(rng), len(rng));
-		fluid.porePressure[p] = 1e3 * unit(rng);
-		fluid.porosity[p]     = 0.4;
-	}
-	SoilParameters soil;
-	WaterParameters water;
-	water.bulkModulus = 2.2e7; // a storage term of the size of the conductance
-	BoundaryConditions bcs;
-	bcs.periodic                                    = { periodicX, false, false };
-	for (int f = periodicX ? 2 : 0; f < faceCount; ++f) bcs.walls[f].water = WaterWall::Impermeable;
-	bcs.walls[static_cast<int>(Face::ZMax)].water   = WaterWall::Drained;
-	bcs.walls[static_cast<int>(Face::ZMax)].drainedPressure = 750;
-	std::vector<SolidSet>       solids { SolidSet { &solid, soil } };
-	std::vector<WaterPointSet*> waters { &fluid };
-	ScatterWorkspace            ws;
-	stages::resetGrid(fields);
-	stages::mapSolidToGrid<GimpKernel>(grid, solids, &water, Vec3::Zero(), fields, ws);
-	stages::computeNodalPorosity(fields);
-	stages::mapWaterToGrid<GimpKernel>(grid, waters, Vec3::Zero(), fields, ws);
-	PressureSystem system;
-	stages::classifyPressureNodes<GimpKernel>(grid, fields, waters, bcs, Vec3::Zero(), water.density, system);
-	// walls holding a phase along one axis at some nodes make λ differ between the axes (eq. 8.5 with holds)
-	ConstrainedNodes                 held;
-	std::vector<std::array<bool, 3>> heldSolid;
-	for (std::size_t I = 0; I < grid.nodeCount(); I += 3) {
-		NodeConstraint constraint;
-		constraint.water[1] = I % 2 == 0;
-		held.node.push_back(I);
-		held.constraint.push_back(constraint);
-		heldSolid.push_back({ I % 2 == 1, false, I % 4 == 1 });
-	}
-	stages::assemblePressureSystem<GimpKernel>(grid, fields, solids, waters, water, held, heldSolid, dt, 1e-12, 1e-12, system);
+	RandomPressureScene scene(periodicX);
+	const GridGeometry&    grid   = scene.grid;
+	const GridFields&      fields = scene.fields;
+	const WaterPointSet&   fluid  = scene.fluid;
+	const WaterParameters& water  = scene.water;
+	const Real             dt     = scene.dt;
+	PressureSystem&        system = scene.system;
+	std::mt19937_64&       rng    = scene.rng;
+	auto&                  unit   = scene.unit;
 	std::map<std::pair<std::size_t, std::size_t>, Real> K; // grid nodes (I, J) → K_IJ
 	if (extraPairs) {
 		const std::size_t active = system.node.size();
@@ -333,6 +360,119 @@ TEST(PressureSystem, MatrixIsThePairSumOfItsDefinition) { expectMatrixIsThePairS
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionAcrossAPeriodicSeamOfThreeCells) { expectMatrixIsThePairSum(true); }
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionWithExtraPairsOutOfOrder) { expectMatrixIsThePairSum(false, true); }
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionWithExtraPairsAcrossAPeriodicSeam) { expectMatrixIsThePairSum(true, true); }
+
+// The capillary surface's pairs (meniscusPairs, eq. 8.5f; PressureProjection.hpp) against their
+// definition evaluated here point by point: for each candidate node I, over the water points,
+// Σ_IJ = Σ_wp V ∇(S_I S_J), g^s_IJ = −Σ_wp V (1 − n) S_I ∇S_J, g^w_IJ = −Σ_wp V n S_I ∇S_J, V^w_I = Σ_wp V S_I;
+// per axis, f_J = (g^s_J + Σ_IJ, g^w_J) (Σ_IJ counted where it exceeds 1e-9 of I's largest: inside the
+// soil it is the points' round-off) and a_J = g^s_J + g^w_J; each pair of nodes J, K gains
+// f_Jᵀ R_I f_K − Δt λ_I a_J a_K / V^w_I, R_I the nodal response Δt M_I⁻¹ with the walls' holds (as the
+// stage leaves it in system.grainResponse / waterResponse: the corrector's, tested there). Pairs with a
+// row fixed at p = 0 that is no candidate, tied to nothing, add exactly zero to what is solved and are
+// left out by both. The stage's slots, thread buffers and emission must give the same sums, one entry
+// per pair of rows (row ≤ column) in row order, with one thread and with two.
+void expectMeniscusPairsAreTheirDefinition(int threads)
+{
+	RandomPressureScene      scene(false);
+	const GridGeometry&      grid   = scene.grid;
+	PressureSystem&          system = scene.system;
+	const std::size_t        active = system.node.size();
+	std::vector<char>        candidate(active, 0);
+	for (std::size_t r = 0; r < active; ++r) candidate[r] = r % 2 == 0 || grid.indices(system.node[r])[2] >= 3; // inside and at the top
+	std::vector<PressureSystem::NodePair> pairs;
+	const int                             before = omp_get_max_threads();
+	omp_set_num_threads(threads);
+	stages::meniscusPairs<GimpKernel>(grid, scene.fields, scene.waters, scene.held, scene.heldSolid, scene.dt, 1e-12, 1e-12, candidate, system, pairs);
+	omp_set_num_threads(before);
+
+	std::map<std::pair<std::size_t, std::size_t>, Real> emitted;
+	for (std::size_t e = 0; e < pairs.size(); ++e) {
+		EXPECT_LE(pairs[e].row, pairs[e].column);
+		if (e > 0) {
+			EXPECT_LE(pairs[e - 1].row, pairs[e].row) << "rows in order";
+		}
+		EXPECT_TRUE(emitted.emplace(std::make_pair(pairs[e].row, pairs[e].column), pairs[e].value).second) << "one entry per pair";
+	}
+	std::vector<char> live(active);
+	for (std::size_t r = 0; r < active; ++r)
+		live[r] = !system.fixed[r] || candidate[r] || system.fixedValue[r] != 0 || (!system.ghostMaster.empty() && system.ghostMaster[r] >= 0);
+	std::map<std::pair<std::size_t, std::size_t>, Real> expected;
+	long                                                withSurface = 0;
+	for (std::size_t r = 0; r < active; ++r) {
+		if (!candidate[r]) continue;
+		const std::size_t I = system.node[r];
+		std::map<std::size_t, Vec3> surface, gs, gw; // per node J
+		Real                        supported = 0;    // V^w_I
+		for (std::size_t p = 0; p < scene.fluid.size(); ++p) {
+			Weights1D w[3];
+			detail::weightsAt<GimpKernel>(grid, scene.fluid.position[p], scene.fluid.halfLength[p], w);
+			std::vector<std::size_t> node;
+			std::vector<Real>        N;
+			std::vector<Vec3>        dN;
+			Real                     n = 0;
+			for (int c = 0; c < 3; ++c)
+				for (int b = 0; b < 3; ++b)
+					for (int a = 0; a < 3; ++a) {
+						node.push_back(grid.index(w[0].first + a, w[1].first + b, w[2].first + c));
+						N.push_back(w[0].value[a] * w[1].value[b] * w[2].value[c]);
+						dN.push_back(Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
+						                  w[0].value[a] * w[1].value[b] * w[2].gradient[c]));
+						n += N.back() * scene.fields.porosity[node.back()];
+					}
+			n = std::clamp<Real>(n, stages::minimumInterpolatedPorosity, 1);
+			const auto at = std::find(node.begin(), node.end(), I);
+			if (at == node.end()) continue;
+			const std::size_t i = static_cast<std::size_t>(at - node.begin());
+			const Real        V = scene.fluid.volume[p];
+			supported += V * N[i];
+			for (std::size_t j = 0; j < node.size(); ++j) {
+				for (auto* sum : { &surface, &gs, &gw }) sum->try_emplace(node[j], Vec3::Zero()); // Eigen leaves a new Vec3 unset
+				surface[node[j]] += V * (dN[i] * N[j] + N[i] * dN[j]);
+				gs[node[j]] -= V * (1 - n) * N[i] * dN[j];
+				gw[node[j]] -= V * n * N[i] * dN[j];
+			}
+		}
+		Real largest = 0;
+		for (const auto& [J, value] : surface) largest = std::max(largest, value.norm());
+		if (!(largest > 0)) continue;
+		++withSurface;
+		// Δt/V^w_I; none where I's support holds water points only at its edge (S_I = 0, ∇S_I ≠ 0)
+		const Real perVolume = supported > 0 ? scene.dt / supported : 0;
+		const Vec3 ss = system.grainResponse[0][I], sw = system.grainResponse[1][I], ws = system.waterResponse[0][I], ww = system.waterResponse[1][I];
+		for (int d = 0; d < 3; ++d) EXPECT_NEAR(sw[d], ws[d], 1e-12 * std::abs(ss[d]) + 1e-300) << "R_I symmetric";
+		for (const auto& [J, surfaceJ] : surface)
+			for (const auto& [K, surfaceK] : surface) {
+				const int rJ = system.row[J], rK = system.row[K];
+				if (rJ < 0 || rK < 0 || rJ > rK || !live[static_cast<std::size_t>(rJ)] || !live[static_cast<std::size_t>(rK)]) continue;
+				Real value = 0;
+				for (int d = 0; d < 3; ++d) {
+					const Real fJs = gs[J][d] + (surfaceJ.norm() > 1e-9 * largest ? surfaceJ[d] : 0), fJw = gw[J][d];
+					const Real fKs = gs[K][d] + (surfaceK.norm() > 1e-9 * largest ? surfaceK[d] : 0), fKw = gw[K][d];
+					const Real cross = 0.5 * (sw[d] + ws[d]);
+					value += fJs * (ss[d] * fKs + cross * fKw) + fJw * (cross * fKs + ww[d] * fKw)
+					         - perVolume * system.mobility[I][d] * (gs[J][d] + gw[J][d]) * (gs[K][d] + gw[K][d]);
+				}
+				expected[{ static_cast<std::size_t>(rJ), static_cast<std::size_t>(rK) }] += value;
+			}
+	}
+	EXPECT_GT(withSurface, 20); // the top's nodes and the walls' (the box's points end 3 cm inside them)
+	Real scale = 0;
+	for (const auto& [pair, value] : expected) scale = std::max(scale, std::abs(value));
+	ASSERT_GT(scale, 0);
+	long checked = 0;
+	for (const auto& [pair, value] : expected) {
+		const auto found = emitted.find(pair);
+		const Real got   = found == emitted.end() ? 0 : found->second;
+		EXPECT_NEAR(got, value, 1e-10 * scale) << "rows " << pair.first << ", " << pair.second;
+		checked += std::abs(value) > 1e-6 * scale;
+	}
+	for (const auto& [pair, value] : emitted) EXPECT_TRUE(expected.count(pair)) << "a pair the definition has not: rows " << pair.first << ", " << pair.second;
+	EXPECT_GT(checked, 1000);
+	std::printf("%ld candidate nodes with surface terms, %zu pairs, %ld of them above 1e-6 of the largest\n", withSurface, pairs.size(), checked);
+}
+
+TEST(CapillarySurfacePairs, AreTheirDefinitionOnOneThread) { expectMeniscusPairsAreTheirDefinition(1); }
+TEST(CapillarySurfacePairs, AreTheirDefinitionOnTwoThreads) { expectMeniscusPairsAreTheirDefinition(2); }
 
 // Eqs. 8.5b and 8.5d: a surface that slopes across the grid. Free water fills a box below the plane
 // z = z0 + x tan γx + y tan γy (water points on a lattice of m per cell and axis, kept where the centre
