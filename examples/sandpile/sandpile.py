@@ -93,6 +93,11 @@ parser.add_argument("--hold-time", type=float, help="head held at the crest afte
 parser.add_argument("--submerged", action="store_true",
                     help="the pile under still water (yade_mpm.sandpile.SUBMERGED: excess pore pressure, theory.md eq. 1.9; "
                          "semi-implicit, the head rising over a laboratory minute)")
+parser.add_argument("--spill-at-ground", action="store_true",
+                    help="the reservoir spills over the crest once its level reaches the ground at the inflow face (the crest "
+                         "subsided by the slide): the face's head is held at most at that ground, the overflow's depth and its flow "
+                         "over the crest neglected. Default: the history's head, which stands above that ground once the crest has "
+                         "subsided and which the model cannot spill (doc/sandpile.md)")
 parser.add_argument("--head-end", type=float, help="inflow water level at the end of the rise [m] (default the scene's)")
 parser.add_argument("--crest-lid", action="store_true",
                     help="an impermeable lid on the crest, smooth unless --lid-friction (the domain's top at the crest height; yade_mpm.sandpile.SandPileScene.crest_lid)")
@@ -144,6 +149,8 @@ SEMI_IMPLICIT = args.scheme == "semi-implicit"
 # the explicit step follows the water's wave: the laboratory history would take days there
 SCENE = sandpile.SUBMERGED if args.submerged else sandpile.DEFAULT if SEMI_IMPLICIT else sandpile.COMPRESSED
 SUBMERGED = SCENE.still_water_level is not None
+if SUBMERGED and args.spill_at_ground:
+    raise SystemExit("--spill-at-ground is for a pile in air (its still water stands above the ground by design: --submerged)")
 if SUBMERGED and args.scheme != "semi-implicit":
     raise ValueError("--submerged runs on --scheme semi-implicit (got %r)" % args.scheme)
 if args.crest_lid:
@@ -274,8 +281,14 @@ recorder = MpmHdf5Recorder(label="recorder", file=os.path.join(OUT, "sandpile.h5
 O.engines = [engine, recorder, yade_mpm.progress(seconds=60)]  # a progress line with an ETA every minute
 
 
+def inflow_head(t):
+    """The water level [m] the inflow face holds at time t: the history's, or with --spill-at-ground at most
+    the ground at the face (the reservoir spilling over the subsided crest)."""
+    return min(SCENE.head(t), ground_at_inflow()) if args.spill_at_ground else SCENE.head(t)
+
+
 def head_table(t):
-    return (SCENE.head(t), NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE)
+    return (inflow_head(t), NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE, NO_TABLE)
 
 
 # --- probes and the toe ----------------------------------------------------------------------------
@@ -375,7 +388,7 @@ while O.time < DURATION - 0.5 * O.dt:  # O.time sums O.dt: thousands of round-of
         raise RuntimeError("water mass balance failed at t = %.4f s: (stored + removed − initial − injected)/(initial + injected) = %.3e"
                            % (O.time, residual))
     speed = np.linalg.norm(solid.vel, axis=1)
-    row = {"time_s": O.time, "head_m": SCENE.head(O.time), "toe_displacement_m": toe_displacement(), "face_displacement_m": face_displacement(),
+    row = {"time_s": O.time, "head_m": inflow_head(O.time), "toe_displacement_m": toe_displacement(), "face_displacement_m": face_displacement(),
            "max_solid_speed_m_per_s": float(speed.max()), "water_points": fluid.count, "injected_kg": engine.injectedWaterMass,
            "removed_kg": engine.removedWaterMass, "stored_kg": stored, "balance_residual": residual, "inertia_scale": engine.inertiaScale,
            "inertia_ratio": engine.inertiaRatio,
@@ -487,7 +500,7 @@ if onset_index is not None and settled is not None:
 overtopped = None
 if not SUBMERGED:
     # the margin of the ground over the head falls below 0: read at the time and at the head
-    margin = [r["ground_at_inflow_m"] - r["head_m"] for r in rows]
+    margin = [r["ground_at_inflow_m"] - SCENE.head(r["time_s"]) for r in rows]  # the history's head, spilt or not
     t_over = yade_mpm.analysis.falls_below([r["time_s"] for r in rows], margin, level=0.0)
     if t_over is not None:
         overtopped = {"time_s": t_over, "head_m": SCENE.head(t_over),  # and how far the toe had moved by then [m]
@@ -548,6 +561,7 @@ summary = {
     # on the laboratory reservoir would spill over the crest, which the model does not represent (None: never;
     # also for a submerged pile, whose still water above the ground is part of the model, eq. 1.9)
     "inflow_overtopped": overtopped,
+    "spill_at_ground": args.spill_at_ground,  # whether the face's head was held at most at that ground from then on
     "mobilised_volume_m3": mobilised,
     "mobilised_fraction": mobilised_fraction,
     "deposit_profile": {"x_m": deposit_x.tolist(), "z_m": [None if np.isnan(z) else float(z) for z in deposit_z]},
