@@ -319,8 +319,8 @@ inflow_column = np.flatnonzero(start_positions[:, 0] < CELL)  # the solid points
 def ground_at_inflow():
     """Ground height [m] at the inflow face: the top of the first cell's column of solid points (their
     domain's upper edge). Where the head stands above it the reservoir would spill over the crest, which
-    the model does not represent (free water above the soil leaves through the filtering cloth, the ground
-    next to the face stays a drained surface, p = 0)."""
+    the model does not represent (it holds no water above the soil, and the ground next to the face stays
+    a drained surface, p = 0)."""
     return float(solid.pos[inflow_column, 2].max() + 0.5 * spacing)
 
 
