@@ -14,12 +14,13 @@ The estimate is the time left to O.stopAtTime when one is set and ahead, else to
 current O.run(n) (O.stopAtIter), at the mean rate since the first report. It is off unless added.
 """
 import builtins
+import os
 import sys
 import time
 
 import yade.wrapper
 
-_REGISTRY = "_yade_mpm_progress"  # builtins name under which PyRunner finds the reporters
+_REGISTRY = "_yade_mpm_progress"  # builtins name under which this process keeps its reporters
 
 
 def _duration(seconds):
@@ -74,6 +75,25 @@ class Reporter:
         stream.flush()
 
 
+def report(key, label="progress"):
+    """What a progress() PyRunner calls: its reporter reports. A scene saved with O.save and loaded in
+    another process (O.load) has no reporter there under its key: one is made for stdout on the first
+    call, so the loaded runner goes on reporting instead of stopping the run."""
+    registry = _registry()
+    if key not in registry:
+        registry[key] = Reporter(None, label)
+    registry[key]()
+
+
+def _registry():
+    """This process's reporters by key, in the order they were made (a dict kept in builtins)."""
+    registry = getattr(builtins, _REGISTRY, None)
+    if registry is None:
+        registry = {}
+        setattr(builtins, _REGISTRY, registry)
+    return registry
+
+
 def progress(seconds=30.0, iterations=0, stream=None, label="progress"):
     """A PyRunner that reports progress every `seconds` of wall time [s] (> 0, default 30), or, if
     `iterations` > 0, every that many steps instead; `stream` defaults to sys.stdout. The lines it
@@ -82,17 +102,19 @@ def progress(seconds=30.0, iterations=0, stream=None, label="progress"):
         raise ValueError("progress: iterations = %r is outside the valid range: a whole number ≥ 0 (0: use seconds)" % (iterations,))
     if iterations == 0 and not (seconds > 0 and seconds < float("inf")):
         raise ValueError("progress: seconds = %r s is outside the valid range (0, inf) (or give iterations > 0)" % (seconds,))
-    registry = getattr(builtins, _REGISTRY, None)
-    if registry is None:
-        registry = []
-        setattr(builtins, _REGISTRY, registry)
-    registry.append(Reporter(stream, label))
-    command = "%s[%d]()" % (_REGISTRY, len(registry) - 1)
+    registry = _registry()
+    # the key names this process, so that a loaded scene's runner never reports into a reporter this
+    # process made for its own runners (another stream)
+    key = "%d-%d" % (os.getpid(), len(registry))
+    registry[key] = Reporter(stream, label)
+    # the command imports what it calls: after an O.load in a new process, PyRunner's namespace holds
+    # neither this module nor its reporters
+    command = "__import__('yade_mpm.monitor').monitor.report(%r, %r)" % (key, label)
     if iterations:
         return yade.wrapper.PyRunner(command=command, iterPeriod=int(iterations), label=label)
     return yade.wrapper.PyRunner(command=command, realPeriod=float(seconds), label=label)
 
 
 def reporters():
-    """The reporters made by progress() in this process, in order."""
-    return getattr(builtins, _REGISTRY, [])
+    """The reporters made by progress() in this process (or for the runners of a loaded scene), in order."""
+    return list(_registry().values())

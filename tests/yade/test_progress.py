@@ -57,3 +57,39 @@ def test_eta_to_stop_at_time_from_the_measured_rate():
 def test_bad_periods_are_refused(kwargs, message):
     with pytest.raises(ValueError, match=message):
         yade_mpm.progress(**kwargs)
+
+
+def test_a_saved_scene_with_progress_reports_after_loading_in_a_new_process(tmp_path):
+    """A scene saved with its progress runner (O.save) and loaded in another process (O.load) goes on
+    running and reporting: the runner's command imports what it calls. Before, it named a reporter
+    registry of the saving process, so the loaded scene's first report stopped the run with a
+    NameError."""
+    from conftest import YADE, run_script
+    save = run_script("""
+        import yade_mpm
+        from yade import O, wrapper as w
+        soil, water = w.MpmSoilMat(), w.MpmWaterMat()
+        O.materials.append([soil, water])
+        g = (0, 0, -9.81)
+        O.bodies.append(list(yade_mpm.saturated_block((0, 0, 0), (0.05, 0.05, 0.1), 0.05, soil, water, points_per_cell=2, gravity=g)))
+        O.engines = [w.MpmTwoPhaseEngine(label="mpm", gravity=g, domainMin=(0, 0, 0), domainMax=(0.05, 0.05, 0.1), cellSize=0.05,
+                                         solidWalls=("slip",) * 4 + ("fixed", "free"), waterWalls=("impermeable",) * 5 + ("drained",)),
+                     yade_mpm.progress(iterations=2)]
+        O.dt = 1e-3
+        O.run(2, True)
+        O.save("scene.yade.gz")
+    """, tmp_path, interpreter=YADE, name="save.py")
+    assert save.returncode == 0, save.stderr
+    load = run_script("""
+        import yade_mpm  # registers the Mpm classes the file names; makes no reporter
+        from yade import O
+        O.load("scene.yade.gz")
+        O.run(4, True)
+        print("iter", O.iter)
+    """, tmp_path, interpreter=YADE, name="load.py")
+    assert load.returncode == 0, load.stderr
+    # the scene goes on from its saved iteration 2 to 6; the loaded runner (iterPeriod 2) reports at
+    # iterations 2 and 4 (the engines run before O.iter advances), to stdout, the first measuring the rate
+    assert "iter 6" in load.stdout, load.stdout + load.stderr
+    lines = re.findall(r"^\[progress\] t = ([0-9.]+) s, iter (\d+)", load.stdout, re.M)
+    assert lines == [("0.002", "2"), ("0.004", "4")], load.stdout
