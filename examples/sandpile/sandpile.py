@@ -540,6 +540,10 @@ summary = {
     "solver_cpu_time_s": solver_cpu_time,
     "peak_memory_MiB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,  # of this process (YADE included)
     "threads": int(O.numThreads),
+    # the capillary surface's solves (semi-implicit): candidates not held because the water points left their
+    # pressure undetermined (summed over the sub-steps, eq. 8.5h) and sub-steps whose active set did not settle (eq. 8.5f)
+    "undetermined_surface_nodes": engine.undeterminedSurfaceNodes,
+    "unsettled_active_sets": engine.unsettledActiveSets,
     "stable_before_rise": {"toe_displacement_m": settled["toe_displacement_m"] if settled else None,
                            "face_displacement_m": settled["face_displacement_m"] if settled else None,
                            "max_solid_speed_m_per_s": settled["max_solid_speed_m_per_s"] if settled else None},

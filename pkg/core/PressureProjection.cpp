@@ -4,6 +4,7 @@
 #include "Stencil.hpp"
 
 #include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
 
 #include <algorithm>
 #include <cmath>
@@ -910,6 +911,64 @@ namespace stages {
 			if (e.column != e.row) excess[e.column] -= e.value * system.nodalPressure[system.node[e.row]];
 		}
 		return excess;
+	}
+
+	std::size_t dropUndeterminedCandidates(const GridGeometry& grid, const PressureSystem& system, const std::vector<Real>& storage, Real roundOff,
+	                                       std::vector<char>& candidate)
+	{
+		const std::size_t active  = system.node.size();
+		std::size_t       dropped = 0;
+		std::vector<int>  column(active, -1); // per pressure node: its column in K's candidate block, −1 off it
+		std::vector<std::size_t>           nodeOf;
+		std::vector<Eigen::Triplet<Real>> entries;
+		for (;;) {
+			nodeOf.clear();
+			for (std::size_t r = 0; r < active; ++r) {
+				column[r] = candidate[r] ? static_cast<int>(nodeOf.size()) : -1;
+				if (candidate[r]) nodeOf.push_back(r);
+			}
+			const int m = static_cast<int>(nodeOf.size());
+			if (m == 0) return dropped;
+			entries.clear();
+			auto add = [&](std::size_t r, std::size_t J, Real value) {
+				const int i = column[r], j = column[J];
+				if (i < 0 || j < 0 || value == 0) return;
+				entries.emplace_back(i, j, value);
+				if (i != j) entries.emplace_back(j, i, value);
+			};
+			for (const std::size_t r : nodeOf) {
+				const Real*              k   = system.rows.data() + r * PressureSystem::rowStride;
+				const std::array<int, 3> idx = grid.indices(system.node[r]);
+				for (int o = centreSlot; o < PressureSystem::offsets; ++o) {
+					if (k[o - centreSlot] == 0) continue; // a non-zero coefficient joins two pressure nodes
+					const int a = o % 5 - 2, b = (o / 5) % 5 - 2, c = o / 25 - 2;
+					add(r, static_cast<std::size_t>(system.row[grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c))]), k[o - centreSlot]);
+				}
+			}
+			for (const PressureSystem::NodePair& e : system.extraPairs) add(e.row, e.column, e.value);
+			Eigen::SparseMatrix<Real> block(m, m);
+			block.setFromTriplets(entries.begin(), entries.end());
+			Eigen::Matrix<Real, Eigen::Dynamic, 1> scale = block.diagonal();
+			int undetermined = -1;
+			for (int i = 0; i < m && undetermined < 0; ++i)
+				if (!(scale[i] > 0)) undetermined = i; // no equation at all
+			if (undetermined < 0) {
+				scale = scale.cwiseSqrt().cwiseInverse();
+				block = scale.asDiagonal() * block * scale.asDiagonal();
+				const Eigen::SimplicialLDLT<Eigen::SparseMatrix<Real>, Eigen::Lower, Eigen::AMDOrdering<int>> factor(block);
+				const Eigen::Matrix<Real, Eigen::Dynamic, 1> pivots   = factor.vectorD();
+				const auto&                                  original = factor.permutationPinv().indices(); // elimination step → column
+				// only the first small pivot is read: the steps after it divide by it
+				for (int k = 0; k < m && undetermined < 0; ++k) {
+					const int  i     = original[k];
+					const Real floor = std::max(roundOff, storage[nodeOf[static_cast<std::size_t>(i)]] * scale[i] * scale[i]);
+					if (!(pivots[k] > floor)) undetermined = i;
+				}
+			}
+			if (undetermined < 0) return dropped;
+			candidate[nodeOf[static_cast<std::size_t>(undetermined)]] = 0;
+			++dropped;
+		}
 	}
 
 	// Σ_IJ below this share of node I's largest counts as round-off (eq. 8.5e): the sum over points of

@@ -538,6 +538,9 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	// by the tails of its points' weights (more than a cell beyond the surface; a plane surface 0.95 h
 	// below a node fills it to 1.25e-3) has a row all but empty, and held free it leaves K near singular
 	constexpr Real heldSurfaceFilling = 1e-3;
+	// the pivot below which a held node's row is a combination of the others' in double precision (the
+	// numerical rank of a Gram-like matrix; eq. 8.5h, where the water is incompressible)
+	const Real heldSurfaceRoundOff = std::sqrt(std::numeric_limits<Real>::epsilon());
 	using namespace stages;
 	PressureSystem&   sys    = pressureSystem_;
 	const std::size_t active = sys.node.size();
@@ -579,6 +582,19 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	{
 		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.5e–f, one entry per pair of rows
 		meniscusPairs<Kernel>(grid_, fields_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, withTerms, sys, sys.extraPairs);
+	}
+	{
+		// a candidate whose row the other candidates' explain, up to what its water's compressibility adds
+		// (one water point alone reaching nodes that only it tells apart), leaves K singular or nearly so,
+		// with a right-hand side off its range (the skeleton's share is sampled at the solid points): the
+		// solve fails, or the water's bulk modulus turns that share into a pressure. Such a node is not held
+		// (eq. 8.5h). Its floor: its lumped storage n V^w_I/(Kw Δt) (zero for incompressible water)
+		StageTimer        t(stageSeconds_, Stage::AssemblePressure);
+		std::vector<Real> storage(active, 0);
+		for (std::size_t r = 0; r < active; ++r)
+			if (candidate[r]) storage[r] = fields_.porosity[sys.node[r]] * fields_.water[sys.node[r]].volume / (water_.bulkModulus * dt);
+		heldSurfaceDropped_ += dropUndeterminedCandidates(grid_, sys, storage, heldSurfaceRoundOff, candidate);
+		for (std::size_t r = 0; r < active; ++r) held[r] = held[r] && candidate[r];
 	}
 	const std::vector<char> fixed0  = sys.fixed;
 	const std::vector<Real> value0  = sys.fixedValue;

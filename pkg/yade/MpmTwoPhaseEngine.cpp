@@ -149,6 +149,7 @@ void MpmTwoPhaseEngine::action()
 	pressureSolveIterations = solver_->lastPressureSolve().iterations;
 	pressureSolveRounds     = solver_->lastPressureSolve().rounds;
 	unsettledActiveSets     = solver_->unsettledActiveSets();
+	undeterminedSurfaceNodes = solver_->undeterminedSurfaceNodes();
 	solverSteps      = solver_->stepCount();
 	removedWaterMass = removedBefore_ + solver_->removedWaterMass();
 	injectedWaterMass = injectedBefore_ + solver_->injectedWaterMass();
@@ -302,6 +303,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 		readOnly(valueAttr<E>("criticalTimeStep", member(&E::criticalTimeStep), "Critical time step of the last run before timeStepFactor [s]: semi-implicit, h/(skeleton wave + fastest point) (theory.md eq. 8.10); explicit, min of h/(fastest wave + fastest point) and, with explicit drag, the drag limit (eqs. 5.1–5.2)")),
 		readOnly(valueAttr<E>("pressureSolveIterations", member(&E::pressureSolveIterations), "Conjugate-gradient iterations of the last pressure solve of the semi-implicit scheme [-]")),
 		readOnly(valueAttr<E>("pressureSolveRounds", member(&E::pressureSolveRounds), "Pressure solves of the last sub-step [-]: 0 with the explicit scheme, 1 with the semi-implicit one, or with capillarySurface the rounds its active set took to settle (at most 20; theory.md eq. 8.5e)")),
+		readOnly(valueAttr<E>("undeterminedSurfaceNodes", member(&E::undeterminedSurfaceNodes), "Capillary-surface nodes not held since the solver was (re)built, summed over the sub-steps, because the water points left their pressure undetermined: one water point alone reaching nodes that only it tells apart [-] (theory.md eq. 8.5h)")),
 		readOnly(valueAttr<E>("unsettledActiveSets", member(&E::unsettledActiveSets), "Sub-steps since the solver was (re)built whose capillary surface's active set still changed after 20 rounds and was left as the last round had it [-] (theory.md eq. 8.5e)")),
 		readOnly(valueAttr<E>("inertiaScaleReleaseTime", member(&E::inertiaScaleReleaseTime), "End of the O.dt in which inertiaScale returned to 1 (theory.md eq. 4.8c) [s]; -1 while it holds or was never set")),
 		readOnly(valueAttr<E>("drainageStepRatio", member(&E::drainageStepRatio), "Δt/τ of the last sub-step [-], τ = α ρsat κ/μw the time in which the drag relaxes the relative flow (theory.md §8.7b). Semi-implicit: the projection's stabilisation drains a consolidating soil spuriously in proportion to it — Terzaghi at Δt/τ = 1.3, 13, 134, 1340 reads 0.9%, 6%, 21%, 40% of p0 off with pressureCorrections = 0, 0.9%, 0.2%, 0.3%, 1.8% with 2: above about 1, slow drainage wants pressureCorrections = 2")),

@@ -30,6 +30,7 @@ public:
 	long       pressureSolveIterations = 0; // conjugate-gradient iterations of the last pressure solve (semi-implicit) [-]
 	long       pressureSolveRounds = 0; // solves of the capillary surface's active set in the last sub-step (eq. 8.5e) [-]
 	long       unsettledActiveSets = 0; // sub-steps since the solver was built whose active set did not settle (eq. 8.5e) [-]
+	long       undeterminedSurfaceNodes = 0; // capillary-surface nodes not held for want of water points, summed over the sub-steps (eq. 8.5h) [-]
 	yade::Real removedWaterMass = 0; // water mass removed by sinks and at the grid's edge, in total [kg]
 	yade::Real injectedWaterMass = 0; // water mass supplied through inflow faces, in total [kg]
 	yade::Real inertiaScaleReleaseTime = -1; // end of the O.dt in which inertiaScale returned to 1 (eq. 4.8c); −1: not released [s]
