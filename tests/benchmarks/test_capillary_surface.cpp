@@ -260,6 +260,28 @@ TEST(CapillarySurface, APointCutAtAnInflowFaceAboveItsTableLosesOnlyTheCut)
 	EXPECT_NEAR(c.solver->removedWaterMass(), cut, tolerance);
 }
 
+// The semi-implicit step with the capillary surface under gravity g along −z.
+SolverSettings capillarySettings(double g)
+{
+	SolverSettings settings;
+	settings.gravity          = Vec3(0, 0, -g);
+	settings.scheme           = TimeScheme::SemiImplicit;
+	settings.capillarySurface = true;
+	return settings;
+}
+
+// The last step's K on the free rows is symmetric with positive eigenvalues; `smallest` keeps the least
+// ratio of its smallest eigenvalue to its largest seen so far.
+void expectPositiveDefinite(const TwoPhaseSolver& solver, int step, double& smallest)
+{
+	const Eigen::MatrixXd K(solver.pressureSystem().matrix);
+	ASSERT_LT((K - K.transpose()).norm(), 1e-12 * K.norm()) << "step " << step;
+	const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> spectrum(K, Eigen::EigenvaluesOnly);
+	ASSERT_GT(spectrum.eigenvalues().minCoeff(), 0) << "step " << step << ": K is not positive definite, smallest eigenvalue "
+	                                                << spectrum.eigenvalues().minCoeff() / spectrum.eigenvalues().maxCoeff() << " of the largest";
+	smallest = std::min(smallest, spectrum.eigenvalues().minCoeff() / spectrum.eigenvalues().maxCoeff());
+}
+
 // A 30° slope in suction above a low table, wet by a film of water half a cell thick over its surface
 // (as the run-out front of the sand pile, where its solve once went wrong): the surface nodes carry
 // little skeleton mass but much water, and the gradient form lumped with their true masses,
@@ -296,22 +318,14 @@ TEST(CapillarySurface, SystemUnderAWetFilmIsPositiveDefiniteAndItsActiveSetSettl
 	for (int f = 0; f < 6; ++f) domain.boundaries.walls[f] = { SolidWall::Free, WaterWall::Free };
 	for (Face f : { Face::XMin, Face::YMin, Face::YMax }) domain.boundaries.walls[static_cast<int>(f)] = { SolidWall::Slip, WaterWall::Impermeable };
 	domain.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
-	SolverSettings settings;
-	settings.gravity          = Vec3(0, 0, -g);
-	settings.scheme           = TimeScheme::SemiImplicit;
-	settings.capillarySurface = true;
-	TwoPhaseSolver solver(domain, settings);
+	const SolverSettings settings = capillarySettings(g);
+	TwoPhaseSolver       solver(domain, settings);
 	solver.setPoints({ SolidSet { &solid, soil, false, SkeletonModel::LinearElastic, StrengthParameters {} } }, { &fluid }, water);
 	const double dt = 0.5 * solver.timeStepLimits().critical;
 	double       smallest = std::numeric_limits<double>::infinity();
 	for (int step = 0; step < 40; ++step) {
 		solver.step(dt);
-		const Eigen::MatrixXd K(solver.pressureSystem().matrix);
-		ASSERT_LT((K - K.transpose()).norm(), 1e-12 * K.norm()) << "step " << step;
-		const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> spectrum(K, Eigen::EigenvaluesOnly);
-		ASSERT_GT(spectrum.eigenvalues().minCoeff(), 0) << "step " << step << ": K is not positive definite, smallest eigenvalue "
-		                                                << spectrum.eigenvalues().minCoeff() / spectrum.eigenvalues().maxCoeff() << " of the largest";
-		smallest = std::min(smallest, spectrum.eigenvalues().minCoeff() / spectrum.eigenvalues().maxCoeff());
+		ASSERT_NO_FATAL_FAILURE(expectPositiveDefinite(solver, step, smallest));
 	}
 	std::printf("slope under a wet film: smallest eigenvalue of K over 40 steps %.2e of its largest; %ld of 40 steps left the active set unsettled\n",
 	            smallest, solver.unsettledActiveSets());
@@ -366,11 +380,8 @@ TEST(CapillarySurface, ALoneGrainAndDropOnTheSurfaceLeaveNoUndeterminedNodeHeld)
 	for (int f = 0; f < 4; ++f) domain.boundaries.walls[f] = { SolidWall::Slip, WaterWall::Impermeable };
 	domain.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
 	domain.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Free };
-	SolverSettings settings;
-	settings.gravity          = Vec3(0, 0, -g);
-	settings.scheme           = TimeScheme::SemiImplicit;
-	settings.capillarySurface = true;
-	TwoPhaseSolver solver(domain, settings);
+	const SolverSettings settings = capillarySettings(g);
+	TwoPhaseSolver       solver(domain, settings);
 	solver.setPoints({ SolidSet { &solid, soil, false, SkeletonModel::LinearElastic, StrengthParameters {} } }, { &fluid }, water);
 	double waterMass = 0;
 	for (std::size_t p = 0; p < fluid.size(); ++p) waterMass += fluid.mass[p];
@@ -381,12 +392,7 @@ TEST(CapillarySurface, ALoneGrainAndDropOnTheSurfaceLeaveNoUndeterminedNodeHeld)
 	double       smallest = std::numeric_limits<double>::infinity(), worst = 0;
 	for (int step = 0; step < 40; ++step) {
 		ASSERT_NO_THROW(solver.step(dt)) << "step " << step;
-		const Eigen::MatrixXd K(solver.pressureSystem().matrix);
-		ASSERT_LT((K - K.transpose()).norm(), 1e-12 * K.norm()) << "step " << step;
-		const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> spectrum(K, Eigen::EigenvaluesOnly);
-		ASSERT_GT(spectrum.eigenvalues().minCoeff(), 0) << "step " << step << ": K is not positive definite, smallest eigenvalue "
-		                                                << spectrum.eigenvalues().minCoeff() / spectrum.eigenvalues().maxCoeff() << " of the largest";
-		smallest = std::min(smallest, spectrum.eigenvalues().minCoeff() / spectrum.eigenvalues().maxCoeff());
+		ASSERT_NO_FATAL_FAILURE(expectPositiveDefinite(solver, step, smallest));
 		for (std::size_t p = 0; p < drop; ++p) worst = std::max(worst, std::abs(fluid.porePressure[p] - gammaW * (H - fluid.position[p].z())));
 	}
 	double stored = 0;
