@@ -9,8 +9,8 @@
 #              with --full also the same scene at h = 1 cm with α held (--inertia-release inf): doc/figures/sandpile_full_*
 #              (68 min on one thread; released at 26-27 s the true inertia's step would make it 6-7 h; the step-error
 #              measurements on the quick pile, doc/sandpile.md Cost knobs, find α costs no accuracy at equal Δt/α, but
-#              the full run's one dynamic event at 57 s, after the head has passed the subsided ground at the
-#              inflow face (a spill over the crest the model does not represent), carries it, doc/sandpile.md Full mode;
+#              the full run's one dynamic event at 57 s is a step-size instability of the capillary surface that α's
+#              larger step crosses (doc/sandpile.md Full mode; with --spill-at-ground the run goes through);
 #              PILE_FULL_MAX_WALL_TIME [s] ends it at a record, the figures of the time reached)
 # Each pile run's summary.json is copied next to its figures, so that doc/ states which run drew them.
 set -euo pipefail
