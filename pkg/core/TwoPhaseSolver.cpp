@@ -593,7 +593,7 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		std::vector<Real> storage(active, 0);
 		for (std::size_t r = 0; r < active; ++r)
 			if (candidate[r]) storage[r] = fields_.porosity[sys.node[r]] * fields_.water[sys.node[r]].volume / (water_.bulkModulus * dt);
-		heldSurfaceDropped_ += dropUndeterminedCandidates(grid_, sys, storage, heldSurfaceRoundOff, candidate);
+		undeterminedSurfaceNodes_ += dropUndeterminedCandidates(grid_, sys, storage, heldSurfaceRoundOff, candidate);
 		for (std::size_t r = 0; r < active; ++r) held[r] = held[r] && candidate[r];
 	}
 	const std::vector<char> fixed0  = sys.fixed;

@@ -130,7 +130,7 @@ public:
 	long                                                unsettledActiveSets() const { return unsettledActiveSets_; }
 	// Capillary-surface candidates not held since setup, summed over the sub-steps, because the water
 	// points left their pressure undetermined (eq. 8.5h).
-	long                                                undeterminedSurfaceNodes() const { return heldSurfaceDropped_; }
+	long                                                undeterminedSurfaceNodes() const { return undeterminedSurfaceNodes_; }
 	const PressureSystem&                               pressureSystem() const { return pressureSystem_; } // the last step's (tests, diagnostics)
 	const GridFields&                                   fields() const { return fields_; }
 	// The inertia scale in force (eq. 4.8b): settings().inertiaScale until the release of eq. 4.8c, 1 after it.
@@ -238,7 +238,7 @@ private:
 	PressureSystem                pressureSystem_; // eq. 8.7 and its scratch
 	PressureSolveReport           lastPressureSolve_ {};
 	long                          unsettledActiveSets_ = 0;
-	long                          heldSurfaceDropped_  = 0;
+	long                          undeterminedSurfaceNodes_ = 0;
 	std::vector<char>             releasedSurface_; // per grid node: a surface node released (seepage face) in the last step (eq. 8.5f)
 	std::vector<std::array<bool, 3>> heldSolid_; // per constrained node: solid components held this step
 	Real                          pressureDiffusivity_ = 0; // c_v [m² s⁻¹] of eq. 4.17b

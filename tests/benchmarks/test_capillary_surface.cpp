@@ -343,9 +343,10 @@ TEST(CapillarySurface, SystemUnderAWetFilmIsPositiveDefiniteAndItsActiveSetSettl
 // rows the others' explain are not held: every step solves, K is symmetric positive definite, the water
 // balance closes, and the column stays hydrostatic up to the pair's weight over the flume's section
 // (a load on a 1D column raises its pore pressure by at most itself, Skempton's B ≤ 1) and a water
-// level raised at most to the pair's top, one spacing s above the surface: γw s + m g/A. Measured
-// 311 Pa of 367 Pa in the second step, then less; 3 of the 4 candidates above the surface not held in
-// each step. With the floor at round-off only (√ε, not the water's storage) the one left held was
+// level raised at most to the pair's top, one spacing s above the surface: γw s + m g/A. The load alone
+// (122 Pa, tried first) is not a bound: the drop wets the node plane above the surface, which moves the
+// discrete surface up and the whole column's pressure with it. Measured 311 Pa of 367 Pa in the second
+// step, then less; 3 of the 4 candidates above the surface not held in each step. With the floor at round-off only (√ε, not the water's storage) the one left held was
 // distinguished from the others by the water's compressibility alone, and the suction under the grain
 // grew 11% a step (−1.2 kPa by the 40th).
 TEST(CapillarySurface, ALoneGrainAndDropOnTheSurfaceLeaveNoUndeterminedNodeHeld)

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from conftest import start_quick_sandpile
+from yade_mpm.sandpile import SandPileScene
 
 OUTPUTS = ["summary.json", "time_series.csv", "time_series.png", "pore_pressure.png", "velocity_at_failure.png", "shear_band.png",
            "shear_band_at_failure.png", "runout.png", "sandpile.h5", "sandpile.xmf"]
@@ -255,11 +256,7 @@ def test_the_head_passing_the_ground_at_the_inflow_face_is_recorded(quick_run):
     the ground stays above the head throughout."""
     _, summary, rows = quick_run
     scene = summary["scene"]
-
-    def history_head(t):  # SandPileScene.head: held, raised linearly, held
-        rise = min(max((t - scene["settle_time"]) / scene["head_ramp_time"], 0), 1)
-        return scene["head_start"] + rise * (scene["head_end"] - scene["head_start"])
-
+    history_head = SandPileScene(**scene).head  # the run's own scene, rebuilt from its summary
     assert rows[0]["ground_at_inflow_m"] == pytest.approx(scene["pile_height"], abs=1e-4)
     margin = [(r["time_s"], r["ground_at_inflow_m"] - history_head(r["time_s"])) for r in rows]
     over = summary["inflow_overtopped"]
