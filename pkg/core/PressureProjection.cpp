@@ -913,8 +913,45 @@ namespace stages {
 		return excess;
 	}
 
-	std::size_t dropUndeterminedCandidates(const GridGeometry& grid, const PressureSystem& system, const std::vector<Real>& storage, Real roundOff,
-	                                       std::vector<char>& candidate)
+	template <class Kernel>
+	std::vector<PressureSystem::NodePair> candidateStorage(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets,
+	                                                       Real bulkModulus, Real dt, const std::vector<char>& candidate, const PressureSystem& system)
+	{
+		std::vector<PressureSystem::NodePair> pairs;
+		const Real invKw = 1 / bulkModulus; // 0 for incompressible water: no storage
+		if (invKw == 0) return pairs;
+		bool any = false;
+		for (const char c : candidate) any = any || c;
+		if (!any) return pairs;
+		constexpr int S = Kernel::stencil;
+		for (const WaterPointSet* set : sets) {
+			const WaterPointSet& P = *set;
+			for (std::size_t p = 0; p < P.size(); ++p) {
+				Weights1D w[3];
+				weightsAt<Kernel>(grid, P, p, w);
+				std::size_t rows[S * S * S];
+				Real        N[S * S * S];
+				int         m = 0;
+				Real        n = 0;
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real NI, const Vec3&) {
+					n += NI * fields.porosity[I];
+					const int r = system.row[I];
+					if (r >= 0 && candidate[static_cast<std::size_t>(r)] && NI != 0) rows[m] = static_cast<std::size_t>(r), N[m] = NI, ++m;
+				});
+				if (m == 0) continue;
+				// as assemblePressureSystem weights it: C/Δt = V n/(Kw Δt) with n interpolated at the point
+				n                  = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
+				const Real storage = P.volume[p] * n * invKw / dt;
+				for (int a = 0; a < m; ++a)
+					for (int b = a; b < m; ++b)
+						pairs.push_back({ std::min(rows[a], rows[b]), std::max(rows[a], rows[b]), storage * N[a] * N[b] });
+			}
+		}
+		return pairs;
+	}
+
+	std::size_t dropUndeterminedCandidates(const GridGeometry& grid, const PressureSystem& system, const std::vector<PressureSystem::NodePair>& storage,
+	                                       Real rankTolerance, std::vector<char>& candidate)
 	{
 		const std::size_t active  = system.node.size();
 		std::size_t       dropped = 0;
@@ -946,12 +983,19 @@ namespace stages {
 				}
 			}
 			for (const PressureSystem::NodePair& e : system.extraPairs) add(e.row, e.column, e.value);
+			Eigen::Matrix<Real, Eigen::Dynamic, 1> assembled = Eigen::Matrix<Real, Eigen::Dynamic, 1>::Zero(m); // K's diagonal, storage included
+			for (const auto& t : entries)
+				if (t.row() == t.col()) assembled[t.row()] += t.value();
+			// the water's storage taken out: what is left is the water points' Darcy and meniscus terms
+			for (const PressureSystem::NodePair& e : storage) add(e.row, e.column, -e.value);
 			Eigen::SparseMatrix<Real> block(m, m);
 			block.setFromTriplets(entries.begin(), entries.end());
 			Eigen::Matrix<Real, Eigen::Dynamic, 1> scale = block.diagonal();
-			int undetermined = -1;
+			// a diagonal left below half the digits of K's (the storage taken out) holds no equation of its own
+			const Real precision   = std::sqrt(std::numeric_limits<Real>::epsilon());
+			int        undetermined = -1;
 			for (int i = 0; i < m && undetermined < 0; ++i)
-				if (!(scale[i] > 0)) undetermined = i; // no equation at all
+				if (!(scale[i] > precision * assembled[i])) undetermined = i;
 			if (undetermined < 0) {
 				scale = scale.cwiseSqrt().cwiseInverse();
 				block = scale.asDiagonal() * block * scale.asDiagonal();
@@ -959,11 +1003,8 @@ namespace stages {
 				const Eigen::Matrix<Real, Eigen::Dynamic, 1> pivots   = factor.vectorD();
 				const auto&                                  original = factor.permutationPinv().indices(); // elimination step → column
 				// only the first small pivot is read: the steps after it divide by it
-				for (int k = 0; k < m && undetermined < 0; ++k) {
-					const int  i     = original[k];
-					const Real floor = std::max(roundOff, storage[nodeOf[static_cast<std::size_t>(i)]] * scale[i] * scale[i]);
-					if (!(pivots[k] > floor)) undetermined = i;
-				}
+				for (int k = 0; k < m && undetermined < 0; ++k)
+					if (!(pivots[k] > rankTolerance)) undetermined = original[k];
 			}
 			if (undetermined < 0) return dropped;
 			candidate[nodeOf[static_cast<std::size_t>(undetermined)]] = 0;
@@ -1420,6 +1461,8 @@ namespace stages {
 	                                                     std::vector<WaterPointSet*>&, const BoundaryConditions&, const Vec3&, const WaterParameters&, \
 	                                                     const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, const PlateMotion*, Real, Real, \
 	                                                     Real, Real, int, PressureSystem&);                                                          \
+	template std::vector<PressureSystem::NodePair> candidateStorage<K>(const GridGeometry&, const GridFields&, const std::vector<WaterPointSet*>&, Real, \
+	                                                                   Real, const std::vector<char>&, const PressureSystem&);                         \
 	template void meniscusPairs<K>(const GridGeometry&, const GridFields&, std::vector<WaterPointSet*>&, const ConstrainedNodes&,                   \
 	                               const std::vector<std::array<bool, 3>>&, Real, Real, Real, const std::vector<char>&, PressureSystem&,          \
 	                               std::vector<PressureSystem::NodePair>&);                                                                                      \

@@ -159,16 +159,23 @@ namespace stages {
 	// has checked finite.
 	std::vector<Real> rowExcess(const GridGeometry& grid, const PressureSystem& system);
 
+	// The water's storage C/Δt (eq. 8.3: Σ_wp V n S_J S_K/(Kw Δt), as assemblePressureSystem adds it to the
+	// rows) between the pressure rows with `candidate` set, one entry per point and pair of its candidate
+	// rows (row ≤ column; entries of the same pair repeat). Empty for incompressible water.
+	template <class Kernel>
+	std::vector<PressureSystem::NodePair> candidateStorage(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets,
+	                                                       Real bulkModulus, Real dt, const std::vector<char>& candidate, const PressureSystem& system);
+
 	// The capillary surface's candidates whose pressure the water points do not determine (theory.md
 	// eq. 8.5h). With every candidate a free unknown, K's block on them (stored rows and surface pairs)
-	// is scaled to a unit diagonal and factorised, L D Lᵀ in a fill-reducing order; D_k is the share of
-	// candidate k's row that the rows eliminated before it do not explain. The first candidate whose D_k
-	// is at most its own floor — `storage` (per pressure node, its water's compressibility term, lumped)
-	// over its diagonal, and at least `roundOff` — is taken out of `candidate`, and the block is factorised
-	// again, until every pivot exceeds its floor (a candidate with an empty row is taken out at once).
-	// Returns how many were taken out.
-	std::size_t dropUndeterminedCandidates(const GridGeometry& grid, const PressureSystem& system, const std::vector<Real>& storage, Real roundOff,
-	                                       std::vector<char>& candidate);
+	// less the water's storage (`storage`, candidateStorage) — the water points' Darcy and meniscus terms
+	// alone — is scaled to a unit diagonal and factorised, L D Lᵀ in a fill-reducing order; D_k is the share
+	// of candidate k's row that the rows eliminated before it do not explain. The first candidate whose D_k
+	// is at most `rankTolerance` is taken out of `candidate`, and the block is factorised again, until every
+	// pivot exceeds it; a candidate whose diagonal is left below √ε of K's once the storage is out has no
+	// equation of its own and is taken out at once. Returns how many were taken out.
+	std::size_t dropUndeterminedCandidates(const GridGeometry& grid, const PressureSystem& system, const std::vector<PressureSystem::NodePair>& storage,
+	                                       Real rankTolerance, std::vector<char>& candidate);
 
 	// The surface nodes' terms of K (theory.md eqs. 8.5e–f): for each pressure node I with `candidate`
 	// set and every pair of nodes J ≤ K its water points reach, Δt [f_Jᵀ M_I⁻¹ f_K − λ_I a_J a_K/V^w_I], where

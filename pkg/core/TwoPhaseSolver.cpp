@@ -538,9 +538,10 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	// by the tails of its points' weights (more than a cell beyond the surface; a plane surface 0.95 h
 	// below a node fills it to 1.25e-3) has a row all but empty, and held free it leaves K near singular
 	constexpr Real heldSurfaceFilling = 1e-3;
-	// the pivot below which a held node's row is a combination of the others' in double precision (the
-	// numerical rank of a Gram-like matrix; eq. 8.5h, where the water is incompressible)
-	const Real heldSurfaceRoundOff = std::sqrt(std::numeric_limits<Real>::epsilon());
+	// the pivot (of the Darcy and meniscus terms scaled to a unit diagonal) below which a held node's row
+	// is a combination of the others': these are covariances, sums of cancelling point terms, and the
+	// pivots of exactly undetermined nodes come out at up to 6 √ε (eq. 8.5h); ε^(1/3) lies well above that
+	const Real heldSurfaceRank = std::cbrt(std::numeric_limits<Real>::epsilon());
 	using namespace stages;
 	PressureSystem&   sys    = pressureSystem_;
 	const std::size_t active = sys.node.size();
@@ -584,16 +585,15 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		meniscusPairs<Kernel>(grid_, fields_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, withTerms, sys, sys.extraPairs);
 	}
 	{
-		// a candidate whose row the other candidates' explain, up to what its water's compressibility adds
-		// (one water point alone reaching nodes that only it tells apart), leaves K singular or nearly so,
-		// with a right-hand side off its range (the skeleton's share is sampled at the solid points): the
-		// solve fails, or the water's bulk modulus turns that share into a pressure. Such a node is not held
-		// (eq. 8.5h). Its floor: its lumped storage n V^w_I/(Kw Δt) (zero for incompressible water)
-		StageTimer        t(stageSeconds_, Stage::AssemblePressure);
-		std::vector<Real> storage(active, 0);
-		for (std::size_t r = 0; r < active; ++r)
-			if (candidate[r]) storage[r] = fields_.porosity[sys.node[r]] * fields_.water[sys.node[r]].volume / (water_.bulkModulus * dt);
-		undeterminedSurfaceNodes_ += dropUndeterminedCandidates(grid_, sys, storage, heldSurfaceRoundOff, candidate);
+		// a candidate whose row the other candidates' explain (one water point alone reaching nodes that only
+		// it tells apart) leaves K singular, or nearly so with compressible water, with a right-hand side off
+		// its range (the skeleton's share is sampled at the solid points): the solve fails, or the water's
+		// bulk modulus turns that share into a pressure. Such a node is not held (eq. 8.5h). The storage does
+		// not count as telling it apart: it scales as 1/Δt against the Darcy terms' Δt, so a floor from it
+		// would keep such nodes held at large steps and drop determined ones at small steps
+		StageTimer t(stageSeconds_, Stage::AssemblePressure);
+		const std::vector<PressureSystem::NodePair> storage = candidateStorage<Kernel>(grid_, fields_, waters_, water_.bulkModulus, dt, candidate, sys);
+		undeterminedSurfaceNodes_ += dropUndeterminedCandidates(grid_, sys, storage, heldSurfaceRank, candidate);
 		for (std::size_t r = 0; r < active; ++r) held[r] = held[r] && candidate[r];
 	}
 	const std::vector<char> fixed0  = sys.fixed;
