@@ -101,6 +101,11 @@ namespace {
 		const Real full = grid.inDomainSupportVolume(idx[0], idx[1], idx[2]);
 		return full > 0 ? fields.water[grid.index(idx[0], idx[1], idx[2])].volume / full : 0;
 	}
+
+	// One water point's share of the storage C/Δt (theory.md eq. 8.3): V n/(Kw Δt), with n the porosity
+	// interpolated at the point (already clamped) and invKw = 1/Kw (0 for incompressible water). Both the
+	// assembly and eq. 8.5h's check (candidateStorage) weight it so, and must agree to the last digit.
+	inline Real waterPointStorage(Real volume, Real porosity, Real invKw, Real dt) { return volume * porosity * invKw / dt; }
 } // namespace
 
 namespace stages {
@@ -426,7 +431,7 @@ namespace stages {
 				// added at the solid points below)
 				const Vec3 relativeFlux = n * relative;
 				const Real divergence   = n * divMixture;
-				const Real storage    = V * n * invKw / dt; // C/Δt (eq. 8.3), consistent: Σ V S_J S_K n/(Kw Δt)
+				const Real storage    = waterPointStorage(V, n, invKw, dt); // consistent: Σ V S_J S_K n/(Kw Δt)
 				const Vec3 conductance = dt * V * lambda;    // Δt L (eq. 8.6), per axis
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n
 				for (int c = 0; c < S; ++c)
@@ -939,9 +944,8 @@ namespace stages {
 					if (r >= 0 && candidate[static_cast<std::size_t>(r)] && NI != 0) rows[m] = static_cast<std::size_t>(r), N[m] = NI, ++m;
 				});
 				if (m == 0) continue;
-				// as assemblePressureSystem weights it: C/Δt = V n/(Kw Δt) with n interpolated at the point
-				n                  = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
-				const Real storage = P.volume[p] * n * invKw / dt;
+				// as assemblePressureSystem weights it
+				const Real storage = waterPointStorage(P.volume[p], std::clamp<Real>(n, minimumInterpolatedPorosity, 1), invKw, dt);
 				for (int a = 0; a < m; ++a)
 					for (int b = a; b < m; ++b)
 						pairs.push_back({ std::min(rows[a], rows[b]), std::max(rows[a], rows[b]), storage * N[a] * N[b] });
