@@ -128,6 +128,9 @@ parser.add_argument("--capillary-surface", action=argparse.BooleanOptionalAction
                          "pile is dry above the table")
 parser.add_argument("--time-step-factor", type=float, metavar="C",
                     help="the engine's timeStepFactor C, 0 < C ≤ 1: sub-steps of C × its critical step (default the engine's, 0.5)")
+parser.add_argument("--flip-blend", type=float, metavar="B",
+                    help="the engine's flipBlend B, 0 ≤ B ≤ 1: the FLIP share of the points' velocity update, the rest PIC "
+                         "(default the engine's, 1: pure FLIP). It changes the pile's answer, not its cost (doc/sandpile.md Cost knobs)")
 parser.add_argument("--points-per-cell", type=int, default=2, metavar="N", help="points per cell and axis of each phase (default 2)")
 parser.add_argument("--shape-function", choices=("linear", "uGIMP", "cpGIMP"), default="uGIMP", help="the engine's shape functions (default uGIMP)")
 parser.add_argument("--sand-from-dem", metavar="DIR",
@@ -276,7 +279,8 @@ engine = MpmTwoPhaseEngine(
     freeSurfaceHoldsSuction=not SEMI_IMPLICIT,  # ... held by capillarity above the phreatic line, a seepage face below it
     capillarySurface=args.capillary_surface,    # the same on the semi-implicit step (theory.md eq. 8.5e)
     removeFreeWater=True,       # the filtering cloth
-    **({} if args.time_step_factor is None else dict(timeStepFactor=args.time_step_factor)))  # the engine refuses C outside (0, 1]
+    **({} if args.time_step_factor is None else dict(timeStepFactor=args.time_step_factor)),  # the engine refuses C outside (0, 1]
+    **({} if args.flip_blend is None else dict(flipBlend=args.flip_blend)))  # and B outside [0, 1]
 recorder = MpmHdf5Recorder(label="recorder", file=os.path.join(OUT, "sandpile.h5"), iterPeriod=1)
 O.engines = [engine, recorder, yade_mpm.progress(seconds=60)]  # a progress line with an ETA every minute
 
@@ -517,6 +521,7 @@ summary = {
     "points_per_phase_initial": int(len(positions)),
     "points_per_cell": args.points_per_cell,
     "time_step_factor": engine.timeStepFactor,
+    "flip_blend": engine.flipBlend,
     "shape_function": args.shape_function,
     "capillary_surface": args.capillary_surface,
     "solid_points": int(solid.count),
