@@ -590,7 +590,9 @@ with open(os.path.join(OUT, "time_series.csv"), "w", newline="") as f:
     writer.writerows(rows)
 
 # --- figures (yade_mpm.plotting) ---------------------------------------------------------------------
-x_max = toe + 0.1
+# the frame reaches a cell past the farthest solid point, so the run-out front shows (at least 0.1 m past the toe;
+# pile_frame caps it at the flume's end)
+x_max = max(toe + 0.1, float(np.max(np.asarray(solid.pos)[:, 0])) + CELL)
 if SUBMERGED:  # excess pressures: at most the final excess head, no suction
     pmax = SCENE.water_density * G * (SCENE.head_end - SCENE.still_water_level)
     pmin = -0.1 * pmax
