@@ -6,14 +6,14 @@
 #              doc/figures/tradeoffs.* (20-40 min; see that script for reusing stored runs)
 #   pile       examples/sandpile/sandpile.py, quick mode (h = 2 cm):
 #              the main job's scene (yade_mpm.sandpile.DEFAULT, laboratory history): doc/figures/sandpile_quick_* (8 min);
-#              with --full also the same scene at h = 1 cm with α held (--inertia-release inf) and the reservoir
-#              spilling over the crest once the head reaches the ground at the inflow face (--spill-at-ground):
+#              with --full also the same scene at h = 1 cm with α held (--inertia-release inf):
 #              doc/figures/sandpile_full_* (50 min on two threads, 4463 CPU s). α is held because released at 26-27 s the
 #              true inertia's step would make it 6-7 h (the step-error measurements on the quick pile, doc/sandpile.md
-#              Cost knobs, find α costs no accuracy at equal Δt/α); the reservoir spills because from 53.7 s the
-#              history's head stands above the subsided crest, which the flume's reservoir cannot hold and the model
-#              cannot represent (it holds no water above the soil), and held there the run meets a step-size
-#              instability of the capillary surface at 57 s (doc/sandpile.md Full mode, doc/theory.md §8 Open);
+#              Cost knobs, find α costs no accuracy at equal Δt/α). Both modes spill the reservoir over the crest once
+#              the history's head reaches the ground at the inflow face (the example's default, --spill-at-ground: from
+#              ≈ 54 s the crest has subsided below the head, which the flume's reservoir cannot hold; held there with
+#              --no-spill-at-ground the full run meets a step-size instability of the capillary surface at 57 s,
+#              doc/sandpile.md Full mode, doc/theory.md §8 Open);
 #              PILE_FULL_MAX_WALL_TIME [s] ends it at a record, the figures of the time reached)
 #   pile-full  the full pile alone (its figures; the quick ones untouched)
 # Each pile run's summary.json is copied next to its figures, so that doc/ states which run drew them.
@@ -53,7 +53,7 @@ run_pile() {
 }
 
 run_full_pile() {
-  run_pile full --inertia-release inf --spill-at-ground ${PILE_FULL_MAX_WALL_TIME:+--max-wall-time "$PILE_FULL_MAX_WALL_TIME"}
+  run_pile full --inertia-release inf ${PILE_FULL_MAX_WALL_TIME:+--max-wall-time "$PILE_FULL_MAX_WALL_TIME"}
 }
 
 for part in "${parts[@]}"; do

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Speed for accuracy of the sand pile (issue 15; not a test): the default pile (yade_mpm.sandpile.DEFAULT:
-# semi-implicit, capillary surface, one-cell plane-strain flume, Dupuit's starting table) on a laboratory
+# semi-implicit, capillary surface, one-cell plane-strain flume, Dupuit's starting table, the reservoir spilling
+# over the crest once the slide has lowered it below the head: the example's defaults) on a laboratory
 # head rise, one knob changed at a time around the quick baseline (h = 2 cm, 2 points per cell, uGIMP,
 # α = 100, the scene's Kw = 2.2e8 Pa, timeStepFactor C = 0.5): ramp time T and 2T; α = 100, 10, 1, and α = 100
 # released at the inertia ratio ε = 0.01 instead of 0.1; C = 0.5, 0.25, 0.125; h = 2 and 1 cm; linear, uGIMP,

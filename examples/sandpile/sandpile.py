@@ -39,9 +39,9 @@ Writes to DIR (default examples/sandpile/out[-quick]):
                                   for slides ≥ 3 cells deep; lem_deep_peak_onset_head_m for the same at
                                   the sand's peak strength, without Davis), water balance
                                   (injected_kg, removed_kg, relative_residual), run time, and when
-                                  the head first stood above the ground at the inflow face
-                                  (inflow_overtopped: the reservoir would spill over the crest, which
-                                  the model does not represent; time series column ground_at_inflow_m)
+                                  the history's head first stood above the ground at the inflow face
+                                  (inflow_overtopped: from then on the reservoir spills over the crest,
+                                  the face's head held at that ground; time series column ground_at_inflow_m)
 The water mass balance (initial + injected = stored + removed) is checked at every record; the run
 stops with an error if it fails to close to 1e-9. If the solver stops the run as unstable (a point
 moving more than a cell in a step, or a pressure solve that does not converge), everything is still
@@ -93,11 +93,12 @@ parser.add_argument("--hold-time", type=float, help="head held at the crest afte
 parser.add_argument("--submerged", action="store_true",
                     help="the pile under still water (yade_mpm.sandpile.SUBMERGED: excess pore pressure, theory.md eq. 1.9; "
                          "semi-implicit, the head rising over a laboratory minute)")
-parser.add_argument("--spill-at-ground", action="store_true",
-                    help="the reservoir spills over the crest once its level reaches the ground at the inflow face (the crest "
-                         "subsided by the slide): the face's head is held at most at that ground, the overflow's depth and its flow "
-                         "over the crest neglected. Default: the history's head, which stands above that ground once the crest has "
-                         "subsided and which the model cannot spill (doc/sandpile.md)")
+parser.add_argument("--spill-at-ground", action=argparse.BooleanOptionalAction, default=None,
+                    help="a pile in air (its default): the reservoir spills over the crest once its level reaches the ground at the "
+                         "inflow face (the crest subsided by the slide), as the flume's does: the face's head is held at most at that "
+                         "ground, the overflow's depth and its flow over the crest neglected. --no-spill-at-ground holds the "
+                         "history's head instead, which then stands above that ground and feeds the soil through a face the "
+                         "reservoir could not wet (doc/sandpile.md)")
 parser.add_argument("--head-end", type=float, help="inflow water level at the end of the rise [m] (default the scene's)")
 parser.add_argument("--crest-lid", action="store_true",
                     help="an impermeable lid on the crest, smooth unless --lid-friction (the domain's top at the crest height; yade_mpm.sandpile.SandPileScene.crest_lid)")
@@ -154,6 +155,8 @@ SCENE = sandpile.SUBMERGED if args.submerged else sandpile.DEFAULT if SEMI_IMPLI
 SUBMERGED = SCENE.still_water_level is not None
 if SUBMERGED and args.spill_at_ground:
     raise SystemExit("--spill-at-ground is for a pile in air (its still water stands above the ground by design: --submerged)")
+if args.spill_at_ground is None:
+    args.spill_at_ground = not SUBMERGED
 if SUBMERGED and args.scheme != "semi-implicit":
     raise ValueError("--submerged runs on --scheme semi-implicit (got %r)" % args.scheme)
 if args.crest_lid:
@@ -286,8 +289,8 @@ O.engines = [engine, recorder, yade_mpm.progress(seconds=60)]  # a progress line
 
 
 def inflow_head(t):
-    """The water level [m] the inflow face holds at time t: the history's, or with --spill-at-ground at most
-    the ground at the face (the reservoir spilling over the subsided crest)."""
+    """The water level [m] the inflow face holds at time t: the history's, at most the ground at the face
+    (the reservoir spilling over the subsided crest; the history's alone with --no-spill-at-ground)."""
     return min(SCENE.head(t), ground_at_inflow()) if args.spill_at_ground else SCENE.head(t)
 
 
@@ -322,9 +325,9 @@ inflow_column = np.flatnonzero(start_positions[:, 0] < CELL)  # the solid points
 
 def ground_at_inflow():
     """Ground height [m] at the inflow face: the top of the first cell's column of solid points (their
-    domain's upper edge). Where the head stands above it the reservoir would spill over the crest, which
-    the model does not represent (it holds no water above the soil, and the ground next to the face stays
-    a drained surface, p = 0)."""
+    domain's upper edge). Where the history's head stands above it the reservoir spills over the crest
+    (the default, --spill-at-ground: the face's head is held there); the model holds no water above the
+    soil, and the ground next to the face stays a drained surface, p = 0."""
     return float(solid.pos[inflow_column, 2].max() + 0.5 * spacing)
 
 
@@ -566,11 +569,11 @@ summary = {
     "lem_deep_onset_head_m": lem_summary["lem_deep_onset_head_m"],
     "lem_deep_peak_onset_head_m": lem_summary["lem_deep_peak_onset_head_m"],
     "runout_m": runout,
-    # when the head first stood above the ground at the inflow face (the crest subsided by the slide): from then
-    # on the laboratory reservoir would spill over the crest, which the model does not represent (None: never;
-    # also for a submerged pile, whose still water above the ground is part of the model, eq. 1.9)
+    # when the history's head first stood above the ground at the inflow face (the crest subsided by the slide): from
+    # then on the laboratory reservoir spills over the crest (None: never; also for a submerged pile, whose still
+    # water above the ground is part of the model, eq. 1.9)
     "inflow_overtopped": overtopped,
-    "spill_at_ground": args.spill_at_ground,  # whether the face's head was held at most at that ground from then on
+    "spill_at_ground": args.spill_at_ground,  # whether the face's head was then held at that ground (else the history's, above it)
     "mobilised_volume_m3": mobilised,
     "mobilised_fraction": mobilised_fraction,
     "deposit_profile": {"x_m": deposit_x.tolist(), "z_m": [None if np.isnan(z) else float(z) for z in deposit_z]},
