@@ -193,14 +193,16 @@ if args.capillary_surface and not SEMI_IMPLICIT:
 SUCTION_ABOVE_TABLE = not SEMI_IMPLICIT or args.capillary_surface
 GRAVITY = np.array([0.0, 0.0, -9.81])  # b [m s⁻²]
 G = float(np.linalg.norm(GRAVITY))  # |g| [m s⁻²]
-CELL = args.cell or (0.02 if args.quick else 0.01)  # h [m]
+CELL = args.cell if args.cell is not None else 0.02 if args.quick else 0.01  # h [m]
+if not 0 < CELL <= SCENE.pile_height / 4:
+    raise ValueError("--cell = %r m is outside the valid range (0, %g] (at least 4 cells over the pile height)" % (CELL, SCENE.pile_height / 4))
 if args.flume_width is None and args.side_wall_friction == 0:
     args.flume_width = CELL  # plane strain between smooth walls: one cell gives the wide flume's answer
 if args.flume_width is not None:
     if not (args.flume_width > 0 and abs(args.flume_width / CELL - round(args.flume_width / CELL)) < 1e-9):
         raise SystemExit("--flume-width %r m must be a positive whole number of cells (h = %g m)" % (args.flume_width, CELL))
     SCENE = dataclasses.replace(SCENE, flume_width=args.flume_width)
-DURATION = args.duration or SCENE.duration()  # [s]
+DURATION = args.duration if args.duration is not None else SCENE.duration()  # [s]
 OUT = args.out or os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "out-quick" if args.quick else "out")
 RECORD_INTERVAL = SCENE.duration() / 70  # time between time-series samples: 1.19 s for the default history [s]
 FIELD_INTERVAL = 5 * RECORD_INTERVAL     # time between HDF5 frames and limit-equilibrium evaluations [s]
@@ -212,8 +214,6 @@ BAND_STRAIN = 10 * SCENE.softening_strain
 # least this deep, next to the shallowest ones the grid can show at all (one cell)
 DEEP_SLIDE_CELLS = 3
 BALANCE_TOLERANCE = 1e-9  # relative water mass balance residual that stops the run [-]
-if not 0 < CELL <= SCENE.pile_height / 4:
-    raise ValueError("--cell = %r m is outside the valid range (0, %g] (at least 4 cells over the pile height)" % (CELL, SCENE.pile_height / 4))
 if not DURATION > 0:
     raise ValueError("--duration = %r s is outside the valid range (0, inf)" % DURATION)
 if args.max_wall_time is not None and not args.max_wall_time > 0:

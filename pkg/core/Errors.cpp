@@ -21,6 +21,11 @@ void requireOpenRange(const std::string& name, double value, double lo, double h
 	if (!(value > lo && value < hi)) throwOutOfRange(name, value, unit, "(" + bound(lo) + ", " + bound(hi) + ")");
 }
 
+void requireLeftOpenRange(const std::string& name, double value, double lo, double hi, const std::string& unit)
+{
+	if (!(value > lo && value <= hi)) throwOutOfRange(name, value, unit, "(" + bound(lo) + ", " + bound(hi) + "]");
+}
+
 void requireClosedRange(const std::string& name, double value, double lo, double hi, const std::string& unit)
 {
 	if (!(value >= lo && value <= hi)) throwOutOfRange(name, value, unit, "[" + bound(lo) + ", " + bound(hi) + "]");

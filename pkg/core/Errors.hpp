@@ -44,6 +44,8 @@ template <class V> [[noreturn]] void throwOutOfRange(const std::string& name, co
 
 // Check lo < value < hi (open interval); bounds may be ±infinity.
 void requireOpenRange(const std::string& name, double value, double lo, double hi, const std::string& unit);
+// Check lo < value <= hi (open below, closed above).
+void requireLeftOpenRange(const std::string& name, double value, double lo, double hi, const std::string& unit);
 // Check lo <= value <= hi (closed interval).
 void requireClosedRange(const std::string& name, double value, double lo, double hi, const std::string& unit);
 

@@ -110,7 +110,7 @@ namespace {
 void SolverSettings::validate() const
 {
 	requireClosedRange("flipBlend", flipBlend, 0, 1, "");
-	requireOpenRange("timeStepFactor", timeStepFactor, 0, 1 + 1e-15, "");
+	requireLeftOpenRange("timeStepFactor", timeStepFactor, 0, 1, "");
 	if (!(freeSurfaceThreshold >= 0 && freeSurfaceThreshold < 1)) throwOutOfRange("freeSurfaceThreshold", freeSurfaceThreshold, "", "[0, 1)");
 	if (freeSurfaceHoldsSuction && !(freeSurfaceThreshold > 0))
 		throw InvalidParameter("freeSurfaceHoldsSuction = true needs a free surface: freeSurfaceThreshold = " + std::to_string(freeSurfaceThreshold) +
