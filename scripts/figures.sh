@@ -7,7 +7,7 @@
 #   pile       examples/sandpile/sandpile.py, quick mode (h = 2 cm):
 #              the main job's scene (yade_mpm.sandpile.DEFAULT, laboratory history): doc/figures/sandpile_quick_* (8 min);
 #              with --full also the same scene at h = 1 cm with α held (--inertia-release inf):
-#              doc/figures/sandpile_full_* (50 min on two threads, 4463 CPU s). α is held because released at 26-27 s the
+#              doc/figures/sandpile_full_* (50 min on two threads, 42 min on one, 2300-4500 CPU s). α is held because released at 26-27 s the
 #              true inertia's step would make it 6-7 h (the step-error measurements on the quick pile, doc/sandpile.md
 #              Cost knobs, find α costs no accuracy at equal Δt/α). Both modes spill the reservoir over the crest once
 #              the history's head reaches the ground at the inflow face (the example's default, --spill-at-ground: from
