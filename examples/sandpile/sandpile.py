@@ -356,7 +356,8 @@ rows, snapshots = [], {}
 profiles = []  # (time, x, height) of the pile's surface at each HDF5 frame: the run-out sequence
 PROFILE_BINS = np.arange(0, SCENE.flume_length + spacing, 2 * spacing)
 record_positions = []  # the solid points' positions at each record (float32): the first mobilised zone is read at the onset
-lem_records = []  # (time, head, critical circle, critical circle ≥ DEEP_SLIDE_CELLS deep or None) of each limit-equilibrium evaluation
+lem_records = []   # (time, head, critical circle) at every record: the shallowest slides' limit equilibrium
+deep_records = []  # (time, head, critical circle ≥ DEEP_SLIDE_CELLS deep, the same at peak strength; None: no such circle) at every frame
 failure = None
 settled = None
 stopped = None  # the solver's message if the run went unstable: what was recorded up to then is kept
@@ -401,18 +402,20 @@ while O.time < DURATION - 0.5 * O.dt:  # O.time sums O.dt: thousands of round-of
            "inertia_ratio": engine.inertiaRatio,
            "kinetic_energy_J": yade_mpm.analysis.kinetic_energy(solid.mass, solid.vel), "ground_at_inflow_m": ground_at_inflow()}
     row.update({"p_%s_Pa" % name.replace(" ", "_"): probe_pressure(loc) for name, loc in PROBES.items()})  # e.g. p_upstream_x=0.05_Pa
-    # Bishop's factor of safety on the run's own pressure field, at every HDF5 frame (about 1 s each)
-    row["lem_factor_of_safety"] = float("nan")
+    # Bishop's factor of safety on the run's own pressure field at every record (1/70 of the history: the
+    # head at which it crosses 1 is resolved as finely as the kinematic onset, 1.8 mm of head on the
+    # default and CI histories; at every frame, 5 records, it was 9 mm on the CI rise); ≈ 0.2 s each
+    circle = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing)
+    row["lem_factor_of_safety"] = circle.factor
+    lem_records.append((O.time, row["head_m"], circle))
     if (record - 1) % records_per_frame == 0:
-        circle = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing)
         try:
             deep = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing, min_depth=DEEP_SLIDE_CELLS * CELL)
             # the same at the model's peak strength: the bound the skeleton can hold before its band softens
             deep_peak = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing, min_depth=DEEP_SLIDE_CELLS * CELL, davis=False)
         except ValueError:  # no circle that deep fits the pile: no such mechanism
             deep = deep_peak = None
-        row["lem_factor_of_safety"] = circle.factor
-        lem_records.append((O.time, row["head_m"], circle, deep, deep_peak))
+        deep_records.append((O.time, row["head_m"], deep, deep_peak))
         profiles.append((O.time, *yade_mpm.analysis.deposit_profile(solid.pos, PROFILE_BINS, half_height=0.5 * spacing)))
     rows.append(row)
     record_positions.append(solid.pos.astype(np.float32))
@@ -460,12 +463,12 @@ sliding = band_base(solid.plasticShearStrain)
 sliding_at_failure = band_base(failure_kappa) if failure is not None else None
 
 # --- limit equilibrium: the head at which Bishop's factor of safety first falls below 1 -----------
-def lem_crossing(which):
-    """Where the factor of the circles `which` (2: shallowest, 3: deep, 4: deep at the peak strength) first lies below 1
-    (yade_mpm.analysis.falls_below: linear between two evaluations, or the first evaluation if the pile starts short of
-    equilibrium; a later fall after the reshaped slope's factor rose again is not its onset), with the critical circle
-    of the evaluation at or after it; None if it never does."""
-    evaluated = [r for r in lem_records if r[which] is not None]
+def lem_crossing(records, which):
+    """Where the factor of the circles `which` of `records` (lem_records 2: shallowest; deep_records 2: deep, 3: deep at
+    the peak strength) first lies below 1 (yade_mpm.analysis.falls_below: linear between two evaluations, or the first
+    evaluation if the pile starts short of equilibrium; a later fall after the reshaped slope's factor rose again is not
+    its onset), with the critical circle of the evaluation at or after it; None if it never does."""
+    evaluated = [r for r in records if r[which] is not None]
     times = [r[0] for r in evaluated]
     crossing = yade_mpm.analysis.falls_below(times, [r[which].factor for r in evaluated])
     if crossing is None:
@@ -475,15 +478,16 @@ def lem_crossing(which):
             "radius_m": circle.radius}
 
 
-lem_onset, lem_deep_onset, lem_deep_peak_onset = lem_crossing(2), lem_crossing(3), lem_crossing(4)
+lem_onset, lem_deep_onset, lem_deep_peak_onset = lem_crossing(lem_records, 2), lem_crossing(deep_records, 2), lem_crossing(deep_records, 3)
 lem_summary = {"method": "Bishop simplified, critical circle (yade_mpm.slope_stability)",
                "strength": "c = 0, Davis (1968) for φ = %.0f°, ψ = %.0f°" % (math.degrees(SCENE.friction_angle), math.degrees(SCENE.dilatancy_angle)),
                "times_s": [r[0] for r in lem_records], "heads_m": [r[1] for r in lem_records],
                "factors": [r[2].factor for r in lem_records], "circles": [r[2].describe() for r in lem_records], "onset": lem_onset,
                "lem_onset_head_m": None if lem_onset is None else lem_onset["head_m"],
-               "deep_min_depth_m": DEEP_SLIDE_CELLS * CELL, "deep_factors": [None if r[3] is None else r[3].factor for r in lem_records], "deep_onset": lem_deep_onset,
+               "deep_min_depth_m": DEEP_SLIDE_CELLS * CELL, "deep_times_s": [r[0] for r in deep_records], "deep_heads_m": [r[1] for r in deep_records],
+               "deep_factors": [None if r[2] is None else r[2].factor for r in deep_records], "deep_onset": lem_deep_onset,
                "lem_deep_onset_head_m": None if lem_deep_onset is None else lem_deep_onset["head_m"],
-               "deep_peak_factors": [None if r[4] is None else r[4].factor for r in lem_records], "deep_peak_onset": lem_deep_peak_onset,
+               "deep_peak_factors": [None if r[3] is None else r[3].factor for r in deep_records], "deep_peak_onset": lem_deep_peak_onset,
                "lem_deep_peak_onset_head_m": None if lem_deep_peak_onset is None else lem_deep_peak_onset["head_m"]}
 
 # --- kinematic onset, run-out, deposit ---------------------------------------------------------------
@@ -493,11 +497,15 @@ lem_summary = {"method": "Bishop simplified, critical circle (yade_mpm.slope_sta
 # a ramp the quasi-static response's own energy grows with it, so that one fires early.
 times = np.array([r["time_s"] for r in rows])
 onset_index = yade_mpm.analysis.compliance_onset([r["head_m"] for r in rows], [r["face_displacement_m"] for r in rows])
+# each onset carries Bishop's factor on the pressures of its own record ("lem_factor"): the limit-equilibrium check read
+# where the model fails, well conditioned where the factor runs flat near 1 and its crossing of 1 is not
 onset = None if onset_index is None else {"time_s": float(times[onset_index]), "head_m": rows[onset_index]["head_m"],
+                                          "lem_factor": rows[onset_index]["lem_factor_of_safety"],
                                           "criterion": "the slope face's displacement per unit head rise exceeds 10× its elastic value over 3 "
                                                        "records (yade_mpm.analysis.compliance_onset)"}
 kinetic_index = yade_mpm.analysis.kinetic_onset(times, [r["kinetic_energy_J"] for r in rows])
 kinetic = None if kinetic_index is None else {"time_s": float(times[kinetic_index]), "head_m": rows[kinetic_index]["head_m"],
+                                              "lem_factor": rows[kinetic_index]["lem_factor_of_safety"],
                                               "criterion": "kinetic energy of the solid grows at each of the next 5 records and by ≥ 10× (yade_mpm.analysis.kinetic_onset)"}
 # the first mobilised zone: the tenth of the solid points displaced most since the rise began, at the
 # onset (the DEM pile's reading, yade_mpm.dem_pile)
@@ -566,6 +574,7 @@ summary = {
     "onset_head_m": None if onset is None else onset["head_m"],
     "first_mobilised_zone": first_zone,
     "lem_onset_head_m": lem_summary["lem_onset_head_m"],
+    "lem_factor_at_onset": None if onset is None else onset["lem_factor"],
     "lem_deep_onset_head_m": lem_summary["lem_deep_onset_head_m"],
     "lem_deep_peak_onset_head_m": lem_summary["lem_deep_peak_onset_head_m"],
     "runout_m": runout,
@@ -628,10 +637,11 @@ if failure is not None:
                                            circle=critical)
 yade_mpm.plotting.runout_sequence(os.path.join(OUT, "runout.png"), profiles + [(O.time, deposit_x, deposit_z)], SCENE, x_max)
 yade_mpm.plotting.time_series(os.path.join(OUT, "time_series.png"), {key: [r[key] for r in rows] for key in rows[0]},
-                              lem=([r[0] for r in lem_records],
-                                   {"Bishop, Davis strength, run's own p": [r[2].factor for r in lem_records],
-                                    "the same, slides ≥ %d cells deep" % DEEP_SLIDE_CELLS: [None if r[3] is None else r[3].factor for r in lem_records],
-                                    "slides ≥ %d cells deep, peak strength (no Davis)" % DEEP_SLIDE_CELLS: [None if r[4] is None else r[4].factor for r in lem_records]}),
+                              lem={"Bishop, Davis strength, run's own p": ([r[0] for r in lem_records], [r[2].factor for r in lem_records]),
+                                   "the same, slides ≥ %d cells deep" % DEEP_SLIDE_CELLS:
+                                       ([r[0] for r in deep_records], [None if r[2] is None else r[2].factor for r in deep_records]),
+                                   "slides ≥ %d cells deep, peak strength (no Davis)" % DEEP_SLIDE_CELLS:
+                                       ([r[0] for r in deep_records], [None if r[3] is None else r[3].factor for r in deep_records])},
                               failure_displacement=FAILURE_DISPLACEMENT, failure_time=failure["time_s"] if failure else None)
 print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "stopped_unstable", "failure", "sliding_surface", "sliding_surface_at_failure", "water_mass_balance",
                                           "stable_before_rise")}, indent=2))

@@ -66,6 +66,8 @@ def collect(runs_dir):
                 # the head at which the lower slope face has moved 1% of H (the example's "failure" record)
                 "face_one_percent_head_m": _head(summary.get("failure"), still),
                 "lem_onset_head_m": None if summary.get("lem_onset_head_m") is None else summary["lem_onset_head_m"] - still,
+                # Bishop's factor on the onset record's own pressures (None: no onset, or a run from before it was recorded)
+                "lem_factor_at_onset": summary.get("lem_factor_at_onset"),
                 "toe_at_end_m": float(columns["toe_displacement_m"][-1]) if len(columns["time_s"]) else None,
                 "runout_m": summary.get("runout_m"),
                 "simulated_time_s": summary["simulated_time_s"],
@@ -159,15 +161,17 @@ def table(rows, machine):
              "kinetic: the solid's kinetic energy grows at each of 5 records and tenfold; face 1%% H: the head at which the lower "
              "slope face's mean displacement passes 1%% of the pile height (a fixed displacement to compare runs by; the onset reads "
              "micrometres); Bishop: F = 1 on the run's own "
-             "pressures (Davis' strength); run-out: the toe front's advance at the end; Δ: relative change against the knob's "
+             "pressures (Davis' strength, evaluated at every record); F at onset: Bishop's factor on the onset record's pressures "
+             "(near 1 where the model fails where limit equilibrium says it should; well conditioned where F runs flat near 1 "
+             "and the head of its crossing is not); run-out: the toe front's advance at the end; Δ: relative change against the knob's "
              "reference run (its most accurate setting where run, else the baseline)."
              % (machine, base["flume_width_m"], base["scheme"], base["settle_time_s"], 1e3 * base["head_start_m"], 1e3 * base["head_end_m"],
                 base["ramp_time_s"], base["hold_time_s"], base["cell_size_m"], base["points_per_cell"] or "–", base["shape_function"] or "–",
                 base["inertia_scale"]),
              "",
              "| knob | setting | solid points | solver CPU time [s] | onset head [mm] | Δ | onset time after rise [s] | Δ | run-out [mm] | Δ "
-             "| kinetic onset head [mm] | face 1% H head [mm] | Bishop F = 1 head [mm] | toe at the end [mm] | note |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| kinetic onset head [mm] | face 1% H head [mm] | Bishop F = 1 head [mm] | F at onset | toe at the end [mm] | note |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r, (reference, c) in zip(rows, changes):
         note = []
         if r["stopped_unstable"]:
@@ -182,12 +186,13 @@ def table(rows, machine):
         if reference == r["name"]:
             note.append("reference")
         own = reference == r["name"]
-        lines.append("| %s | %s | %d | %.0f | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+        lines.append("| %s | %s | %d | %.0f | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
             r["knob"].replace("_", " "), r["setting"], r["solid_points"], _cost(r),
             _mm(r["onset_head_m"]), _f(None if own else c["onset_head_m"], "%+.3f"),
             _f(r["onset_time_after_rise_s"], "%.1f"), _f(None if own else c["onset_time_after_rise_s"], "%+.3f"),
             _mm(r["runout_m"]), _f(None if own else c["runout_m"], "%+.3f"),
-            _mm(r["kinetic_onset_head_m"]), _mm(r["face_one_percent_head_m"]), _mm(r["lem_onset_head_m"]), _mm(r["toe_at_end_m"]), "; ".join(note)))
+            _mm(r["kinetic_onset_head_m"]), _mm(r["face_one_percent_head_m"]), _mm(r["lem_onset_head_m"]),
+            _f(r["lem_factor_at_onset"], "%.2f"), _mm(r["toe_at_end_m"]), "; ".join(note)))
     verdicts = same_answer(rows, changes)
     safe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if ok]
     unsafe = ["%s %s" % (r["knob"].replace("_", " "), r["setting"]) for r, ok in verdicts if not ok]

@@ -120,8 +120,9 @@ def time_series(path, series, lem=None, failure_displacement=None, failure_time=
     and removed and the change of the water stored; Bishop's factor of safety.
     `series`: columns of the run's time_series.csv as arrays — time_s, head_m, p_<probe>_Pa (any
     number), face_displacement_m, toe_displacement_m, kinetic_energy_J, injected_kg, removed_kg,
-    stored_kg. `lem`: (times [s], {label: factors}) of the limit-equilibrium checks (None entries
-    skipped); `failure_time` [s] marks every panel."""
+    stored_kg. `lem`: {label: (times [s], factors)} of the limit-equilibrium checks, each series at
+    its own times (None entries skipped, the line joining the evaluated ones); `failure_time` [s]
+    marks every panel."""
     _, plt = _pyplot()
     t = np.asarray(series["time_s"], dtype=float)
     fig, axes = plt.subplots(6, 1, figsize=(7, 13), sharex=True)
@@ -149,12 +150,11 @@ def time_series(path, series, lem=None, failure_displacement=None, failure_time=
     water.set_ylabel("water [kg]")
     water.legend(fontsize=7)
     if lem is not None:
-        lem_times, factors = lem
         styles = ("o-", "s--", "^:", "d-.")
-        for i, (label, values) in enumerate(factors.items()):
-            style = styles[i % len(styles)]
+        for i, (label, (lem_times, values)) in enumerate(lem.items()):
             values = np.array([np.nan if v is None else v for v in values], dtype=float)
-            safety.plot(lem_times, values, style, label=label)
+            evaluated = np.isfinite(values)
+            safety.plot(np.asarray(lem_times, dtype=float)[evaluated], values[evaluated], styles[i % len(styles)], ms=3, label=label)
         safety.legend(fontsize=7)
     safety.axhline(1, color="k", lw=0.8)
     safety.set_ylabel("LEM factor of safety [-]")

@@ -6,10 +6,10 @@ import pytest
 from yade_mpm import pile_tradeoffs
 
 
-def _run(directory, onset_head, onset_time, runout, solver_time, stopped=None, settle=1.0, still=0.15):
+def _run(directory, onset_head, onset_time, runout, solver_time, stopped=None, settle=1.0, still=0.15, lem_factor=None):
     """A run whose onset (the compliance criterion: head, time), run-out and solver time are given; the
-    kinetic onset 10 mm of head later, the face's 1% of H 20 mm later, Bishop's F = 1 at 0.227 m, the toe
-    at the end twice the run-out."""
+    kinetic onset 10 mm of head later, the face's 1% of H 20 mm later, Bishop's F = 1 at 0.227 m, Bishop's
+    factor at the onset lem_factor (None: a summary without it), the toe at the end twice the run-out."""
     directory.mkdir()
     summary = {"scene": {"still_water_level": still, "settle_time": settle, "head_start": 0.15, "head_end": 0.27, "head_ramp_time": 60.0,
                          "hold_time": 20.0, "flume_width": 0.02},
@@ -17,7 +17,7 @@ def _run(directory, onset_head, onset_time, runout, solver_time, stopped=None, s
                "onset": None if onset_head is None else {"head_m": onset_head, "time_s": onset_time},
                "kinetic_onset": None if onset_head is None else {"head_m": onset_head + 0.010, "time_s": onset_time + 5.0},
                "failure": None if onset_head is None else {"head_m": onset_head + 0.020, "time_s": onset_time + 10.0},
-               "lem_onset_head_m": 0.227, "runout_m": runout, "simulated_time_s": 81.0, "solver_time_s": 2 * solver_time,
+               "lem_onset_head_m": 0.227, "lem_factor_at_onset": lem_factor, "runout_m": runout, "simulated_time_s": 81.0, "solver_time_s": 2 * solver_time,
                "solver_cpu_time_s": solver_time,
                "solid_points": 500, "inertia_scale_release_time_s": None, "stopped_unstable": stopped}
     (directory / "summary.json").write_text(json.dumps(summary))
@@ -30,7 +30,7 @@ def _run(directory, onset_head, onset_time, runout, solver_time, stopped=None, s
 def runs(tmp_path):
     # baseline: onset 30 mm over the still water at 16 s after the rise, run-out 20 mm; α = 1 (the α knob's
     # reference) within 2% of α = 100 on every answer, α = 10 too; the finer cell runs out 3× as far
-    _run(tmp_path / "baseline", 0.180, 17.0, 0.020, 150)
+    _run(tmp_path / "baseline", 0.180, 17.0, 0.020, 150, lem_factor=0.962)
     _run(tmp_path / "alpha1", 0.1806, 17.2, 0.0202, 1800)
     _run(tmp_path / "alpha10", 0.1803, 17.1, 0.0201, 450)
     _run(tmp_path / "full", 0.170, 12.0, 0.060, 900)
@@ -90,6 +90,8 @@ def test_the_section_between_the_markers_is_replaced_and_the_rest_kept(runs, tmp
     assert text.startswith("# Speed for accuracy\n\nthe oedometer table\n")
     assert text.count("<!-- PILE -->") == 1 and "again\n<!-- /PILE -->" in text
     assert "| inertia scale | α=10 | 500 | 450 | 30.3 | -0.010 |" in text
+    # Bishop's F = 1 head over the still water, then its factor at the onset record: given, or – where not recorded
+    assert "| 77.0 | 0.96 | 40.0 |" in text and "| 77.0 | – | 40.2 |" in text
     # the set-up is read from the baseline's summary and records, not written in: h, ppc, kernel, α, T, resolution
     assert "a rise to 120 mm over T = 60 s, 20 s held" in text and "(h = 0.02 m, 2 points per cell, uGIMP, α = 100)" in text and "(1.00 s and 2.0 mm of head in the baseline)" in text
 

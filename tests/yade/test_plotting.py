@@ -71,12 +71,13 @@ def test_runout_sequence_spreads_its_lines_over_the_run_and_keeps_the_last(tmp_p
 
 def test_time_series_panels_carry_the_columns_given(tmp_path):
     """Six panels: head, every probe column, face and toe in mm, kinetic energy on a log axis, water
-    in, out and the change of the stored water, and the LEM factors with None left out."""
+    in, out and the change of the stored water, and the LEM factors, each series at its own times,
+    with None left out (the line joins the evaluated ones)."""
     t = np.linspace(0, 0.7, 8)
     series = {"time_s": t, "head_m": 0.03 + 0.1 * t, "p_upstream_x=0.05_Pa": 100 * t, "p_near_toe_x=0.27_Pa": 50 * t,
               "face_displacement_m": 1e-3 * t, "toe_displacement_m": 5e-4 * t, "kinetic_energy_J": 1e-9 * np.exp(t),
               "injected_kg": 0.01 * t, "removed_kg": 0.008 * t, "stored_kg": 0.3 + 0.002 * t}
-    lem = ([0.0, 0.35, 0.7], {"all": [1.2, 1.0, 0.8], "deep": [1.3, None, 0.9]})
+    lem = {"all": ([0.0, 0.1, 0.35, 0.7], [1.2, 1.1, 1.0, 0.8]), "deep": ([0.0, 0.35, 0.7], [1.3, None, 0.9])}
     fig = plotting.time_series(tmp_path / "ts.png", series, lem=lem, failure_displacement=1.2e-3, failure_time=0.5)
     head, pressure, displacement, energy, water, safety = fig.axes
     assert np.allclose(head.get_lines()[0].get_ydata(), series["head_m"])
@@ -86,5 +87,7 @@ def test_time_series_panels_carry_the_columns_given(tmp_path):
     water_lines = {ln.get_label(): ln for ln in water.get_lines()}
     assert np.allclose(water_lines["stored − stored at first record"].get_ydata(), 0.002 * t)
     deep = next(ln for ln in safety.get_lines() if ln.get_label() == "deep")
-    assert np.isnan(deep.get_ydata()[1]) and deep.get_ydata()[2] == 0.9
+    assert list(deep.get_xdata()) == [0.0, 0.7] and list(deep.get_ydata()) == [1.3, 0.9]
+    shallow = next(ln for ln in safety.get_lines() if ln.get_label() == "all")
+    assert list(shallow.get_xdata()) == [0.0, 0.1, 0.35, 0.7]
     assert all(any(len(ln.get_xdata()) == 2 and np.allclose(ln.get_xdata(), 0.5) for ln in ax.get_lines()) for ax in fig.axes)  # the failure mark
