@@ -205,7 +205,7 @@ if args.flume_width is not None:
 DURATION = args.duration if args.duration is not None else SCENE.duration()  # [s]
 OUT = args.out or os.path.join(os.path.dirname(os.path.abspath(sys.argv[0])), "out-quick" if args.quick else "out")
 RECORD_INTERVAL = SCENE.duration() / 70  # time between time-series samples: 1.19 s for the default history [s]
-FIELD_INTERVAL = 5 * RECORD_INTERVAL     # time between HDF5 frames and limit-equilibrium evaluations [s]
+FIELD_INTERVAL = 5 * RECORD_INTERVAL     # time between HDF5 frames and the deep limit-equilibrium searches [s]
 FAILURE_DISPLACEMENT = 0.01 * SCENE.pile_height  # mean displacement of the lower slope face that marks failure [m]
 # plastic shear strain that marks a point as part of the shear band: ten softening scales, where the
 # sand has reached its critical state (φ within e⁻¹⁰ of φ_r) [-]

@@ -180,10 +180,9 @@ def test_onset_head_within_ten_percent_of_limit_equilibrium(quick_run):
     of head, and interpolated) and +0.1% on the default 60 s history (0.04151 against 0.04146 m). And the
     same check where it is well conditioned: Bishop's factor on the onset record's own pressures lies
     within 10% of 1 — the model fails where limit equilibrium says it should (measured 0.96; 0.995 on the
-    60 s history). Where F runs
-    flat near 1 the crossing's head is not: at 3 points per cell F stays at 0.99–1.08 from 0.049 to 0.054 m
-    of head, and with F sampled every 5 records (9 mm of head) its crossing read 0.073 m against the
-    onset's 0.054 m (doc/tradeoffs.md). The kinetic onset, the slide's acceleration, is not held to either
+    60 s history). Where F runs flat near 1 the crossing's head is not: at 3 points per cell F stays at
+    0.99–1.08 from 0.049 to 0.054 m of head, and with F sampled every 5 records (9 mm of head) its
+    crossing read 0.073 m against the onset's 0.054 m (doc/tradeoffs.md). The kinetic onset, the slide's acceleration, is not held to either
     (−2.6% here, +47% on the 60 s history: the slump at the toe accelerates only once it has spread up the
     slope)."""
     _, summary, _ = quick_run
@@ -288,16 +287,16 @@ def test_the_reservoir_spills_at_the_ground_and_the_water_flows_into_the_pile(qu
     sunk, fed through a face the reservoir could not wet. 2% allows for the probe's interpolation."""
     _, summary, rows = quick_run
     scene = summary["scene"]
-    history_head = SandPileScene(**scene).head
+    pile = SandPileScene(**scene)
     g = sum(c * c for c in summary["gravity_m_per_s2"]) ** 0.5
-    name, (_, _, z_probe) = [(n, loc) for n, loc in SandPileScene(**scene).probe_points().items() if n.startswith("upstream")][0]
+    name, (_, _, z_probe) = [(n, loc) for n, loc in pile.probe_points().items() if n.startswith("upstream")][0]
     key = "p_%s_Pa" % name.replace(" ", "_")
     # on this history the slide lowers the crest below the head (measured at 22.3 s): the check reaches the spill
     over = summary["inflow_overtopped"]
     assert over is not None and any(r["time_s"] > over["time_s"] for r in rows)
     for r in rows:
         if r["time_s"] >= scene["settle_time"]:
-            level = min(history_head(r["time_s"]), r["ground_at_inflow_m"])
+            level = min(pile.head(r["time_s"]), r["ground_at_inflow_m"])
             assert r[key] <= 1.02 * scene["water_density"] * g * (level - z_probe), r
 
 
