@@ -396,7 +396,7 @@ namespace stages {
 			system.mixtureVelocity[I]    = theta * vs + (1 - theta) * vw;
 			system.relativeVelocity[I]   = theta * (vw - vs);
 		}
-		system.rows.assign(system.node.size() * PressureSystem::rowStride, 0);
+		assignKeepingStorage<Real>(system.rows, system.node.size() * PressureSystem::rowStride, 0);
 		const Real invKw = 1 / water.bulkModulus; // 0 for incompressible water (Kw = ∞)
 		for (std::size_t s = 0; s < sets.size(); ++s) {
 			const WaterPointSet& P     = *sets[s];
@@ -644,9 +644,11 @@ namespace stages {
 			merged[u] = m;
 		}
 		Eigen::SparseMatrix<Real, Eigen::RowMajor>& A = system.matrix;
-		A.resize(n, n);
+		A.resize(n, n); // keeps the entries' storage
 		int nonZeros = 0;
 		for (int u = 0; u < n; ++u) nonZeros += merged[u];
+		// resizeNonZeros grows the storage to exactly its size: with headroom, as assignKeepingStorage
+		if (A.data().allocatedSize() < nonZeros) A.data().reserve(nonZeros + nonZeros / 4);
 		A.resizeNonZeros(nonZeros);
 		A.outerIndexPtr()[0] = 0;
 		for (int u = 0; u < n; ++u) A.outerIndexPtr()[u + 1] = A.outerIndexPtr()[u] + merged[u];

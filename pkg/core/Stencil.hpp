@@ -99,7 +99,7 @@ namespace mpm::detail {
 			return;
 		}
 		buffers.resize(threads - 1);
-		for (auto& b : buffers) b.assign(target.size(), zeroOf(Node {}));
+		for (auto& b : buffers) assignKeepingStorage(b, target.size(), zeroOf(Node {}));
 #pragma omp parallel num_threads(threads)
 		{
 			const int tid = omp_get_thread_num();

@@ -10,6 +10,7 @@
 #include <Eigen/LU> // determinant()
 
 #include <cstddef>
+#include <vector>
 
 namespace mpm {
 
@@ -26,6 +27,17 @@ using Voigt6 = Eigen::Matrix<Real, 6, 1>; // (xx, yy, zz, xy, yz, zx)
 // off the pile, mpm_bench's saturated cubes on two threads, 256 against 1024: 512 soil points 7.6
 // against 5.6, 1000 points 6.8 against 5.3 ×10⁵ point-steps/s, explicit 512 points 11.3 against 6.6.)
 constexpr std::size_t parallelThreshold = 256;
+
+// `v` set to n copies of `value` in the storage it already has; where it must grow, by a quarter more
+// than asked. std::vector::assign grows to exactly n, so a count that creeps up from step to step (the
+// pressure nodes a spreading flow reaches) took fresh storage at every step, and on this VM the first
+// touch of a fresh page costs ~15 µs: 1100 page faults per step on the column, 20% of its time
+// (doc/benchmarks.md, Page faults).
+template <class T> void assignKeepingStorage(std::vector<T>& v, std::size_t n, const T& value)
+{
+	if (v.capacity() < n) v.reserve(n + n / 4);
+	v.assign(n, value);
+}
 
 inline Mat3 voigtToMatrix(const Voigt6& s)
 {
