@@ -608,8 +608,8 @@ namespace stages {
 		for (int i = 0; i < n; ++i) count[i + 1] += count[i];
 		std::vector<int>&  column = system.columnScratch;
 		std::vector<Real>& value  = system.valueScratch;
-		column.resize(count[n]);
-		value.resize(count[n]);
+		resizeKeepingStorage(column, static_cast<std::size_t>(count[n]));
+		resizeKeepingStorage(value, static_cast<std::size_t>(count[n]));
 		std::vector<int>& cursor = system.cursorScratch;
 		cursor.assign(count.begin(), count.end() - 1);
 		for (const Pair& e : pairs) {

@@ -39,6 +39,13 @@ template <class T> void assignKeepingStorage(std::vector<T>& v, std::size_t n, c
 	v.assign(n, value);
 }
 
+// `v` resized to n (new entries value-initialised) in the storage it has, grown as assignKeepingStorage.
+template <class T> void resizeKeepingStorage(std::vector<T>& v, std::size_t n)
+{
+	if (v.capacity() < n) v.reserve(n + n / 4);
+	v.resize(n);
+}
+
 inline Mat3 voigtToMatrix(const Voigt6& s)
 {
 	Mat3 m;
