@@ -648,7 +648,7 @@ namespace stages {
 		int nonZeros = 0;
 		for (int u = 0; u < n; ++u) nonZeros += merged[u];
 		// resizeNonZeros grows the storage to exactly its size: with headroom, as assignKeepingStorage
-		if (A.data().allocatedSize() < nonZeros) A.data().reserve(nonZeros + nonZeros / 4);
+		if (A.data().allocatedSize() < nonZeros) A.data().reserve(static_cast<Eigen::Index>(withHeadroom(static_cast<std::size_t>(nonZeros))));
 		A.resizeNonZeros(nonZeros);
 		A.outerIndexPtr()[0] = 0;
 		for (int u = 0; u < n; ++u) A.outerIndexPtr()[u + 1] = A.outerIndexPtr()[u] + merged[u];

@@ -28,21 +28,25 @@ using Voigt6 = Eigen::Matrix<Real, 6, 1>; // (xx, yy, zz, xy, yz, zx)
 // against 5.6, 1000 points 6.8 against 5.3 ×10⁵ point-steps/s, explicit 512 points 11.3 against 6.6.)
 constexpr std::size_t parallelThreshold = 256;
 
-// `v` set to n copies of `value` in the storage it already has; where it must grow, by a quarter more
-// than asked. std::vector::assign grows to exactly n, so a count that creeps up from step to step (the
-// pressure nodes a spreading flow reaches) took fresh storage at every step, and on this VM the first
-// touch of a fresh page costs ~15 µs: 1100 page faults per step on the column, 20% of its time
-// (doc/benchmarks.md, Page faults).
+// The capacity a per-step array takes when it must grow: a quarter more than asked. std::vector::assign and
+// Eigen's resizeNonZeros grow to exactly the size asked, so a count that creeps up from step to step (the
+// pressure nodes a spreading flow reaches) took fresh storage at every step (std::vector::resize doubles,
+// but copies the whole at that step), and on this VM
+// the first touch of a fresh page costs ~15 µs: 1394 page faults per step on the column, a fifth of its
+// time (doc/benchmarks.md, Page faults).
+constexpr std::size_t withHeadroom(std::size_t n) { return n + n / 4; }
+
+// `v` set to n copies of `value` in the storage it already has, grown to withHeadroom(n) where it must.
 template <class T> void assignKeepingStorage(std::vector<T>& v, std::size_t n, const T& value)
 {
-	if (v.capacity() < n) v.reserve(n + n / 4);
+	if (v.capacity() < n) v.reserve(withHeadroom(n));
 	v.assign(n, value);
 }
 
 // `v` resized to n (new entries value-initialised) in the storage it has, grown as assignKeepingStorage.
 template <class T> void resizeKeepingStorage(std::vector<T>& v, std::size_t n)
 {
-	if (v.capacity() < n) v.reserve(n + n / 4);
+	if (v.capacity() < n) v.reserve(withHeadroom(n));
 	v.resize(n);
 }
 

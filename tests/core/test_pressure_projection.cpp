@@ -106,30 +106,56 @@ struct DrainedBlock {
 	}
 };
 
-// K's stored rows, the CSR's entries and the scatter's private copies are sized by the pressure nodes the
-// water points reach, a count that creeps up from step to step where the flow spreads (the column of
-// doc/benchmarks.md: 3.98, 4.01, 4.03 MB of rows in three steps). std::vector::assign grows to exactly the
-// size asked, so every such step took fresh storage and faulted its pages in again (1394 page faults per
-// step, 20% of the column's time). assignKeepingStorage grows by a quarter more than asked: a count rising
-// 1% per step for 20 steps (22% in all) is served by the first step's storage, a falling one keeps it,
-// and the contents are always n copies of the value.
-TEST(PressureSystem, StorageIsKeptWhileTheNodeCountCreepsUp)
+// K's stored rows are sized by the pressure nodes the water points reach, a count that moves from step to
+// step where the water flows: on a column loaded on its drained top the expelled
+// water reaches new nodes at the top (doc/benchmarks.md, Page faults: 3.98, 4.01, 4.03 MB of rows in three
+// steps on the reference's column). Grown to exactly the size asked, they took fresh storage whenever the
+// count passed its largest so far and faulted its pages in again (1394 page faults per step, a fifth of
+// the column's time). Grown with a quarter of headroom (assignKeepingStorage), the storage of the first
+// steps serves a count that stays within that quarter. On the small column below the count jumps from 432
+// to 640 nodes in the second step (the expelled water's first layer), then moves by ±4% (616–644): the
+// test requires that it passes its earlier maximum at least once after the jump (where storage of exactly
+// the size asked had to move; otherwise the test shows nothing) and stays within 25% of it, and that the
+// rows' storage does not move after the jump (with withHeadroom(n) = n it moves once: checked). The CSR's
+// entries grow by the same rule, but this column's non-zeros never pass their count of the jump's step,
+// so they are not asserted here (the column of doc/benchmarks.md measured them).
+TEST(PressureSystem, StorageIsKeptWhileTheNodeCountMoves)
 {
-	std::vector<double> rows;
-	std::size_t         n = 1000;
-	assignKeepingStorage(rows, n, 0.0);
-	const double* first = rows.data();
-	for (int step = 0; step < 20; ++step) {
-		n += n / 100;
-		rows[0] = 1; // a step's sums, to be cleared by the next assign
-		assignKeepingStorage(rows, n, 0.0);
-		EXPECT_EQ(rows.data(), first) << "step " << step << ": " << n << " entries";
-		ASSERT_EQ(rows.size(), n);
-		EXPECT_EQ(std::count(rows.begin(), rows.end(), 0.0), static_cast<long>(n));
+	const Real      h = 0.02, g = 9.81;
+	const Vec3      size(0.06, 0.06, 0.3);
+	SoilParameters  soil;
+	WaterParameters water;
+	soil.youngModulus          = 9.8e7;
+	soil.porosity              = 0.3;
+	soil.intrinsicPermeability = 1e-3 * water.viscosity / (water.density * g); // k = 1e-3 m/s: the water moves within the run
+	const auto    lattice = fixtures::lattice(Vec3::Zero(), size, h, 2);
+	SolidPointSet solid   = fixtures::solidLattice(lattice, soil.porosity, soil.density);
+	WaterPointSet fluid   = fixtures::waterLattice(lattice, soil.porosity, water.density);
+	for (std::size_t p = 0; p < solid.size(); ++p) // 100 kPa on the top layer of solid points
+		if (solid.position[p].z() > size.z() - lattice.spacing) solid.externalForce[p] = Vec3(0, 0, -100e3 * lattice.spacing * lattice.spacing);
+	SolverSettings s;
+	s.gravity = Vec3::Zero();
+	TwoPhaseSolver solver(fixtures::columnDomain(size, h), s);
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	const Real            dt  = 0.5 * solver.timeStepLimits().critical;
+	const PressureSystem& sys = solver.pressureSystem();
+	solver.step(dt);
+	solver.step(dt); // the jump
+	const std::size_t afterJump = sys.node.size();
+	std::size_t       largest = afterJump;
+	int               newMaxima = 0, rowsMoved = 0;
+	const Real*       rows = sys.rows.data();
+	for (int step = 0; step < 11; ++step) {
+		solver.step(dt);
+		newMaxima += sys.node.size() > largest, largest = std::max(largest, sys.node.size());
+		rowsMoved += sys.rows.data() != rows;
+		rows = sys.rows.data();
 	}
-	assignKeepingStorage(rows, n / 2, 2.0);
-	EXPECT_EQ(rows.data(), first);
-	EXPECT_EQ(std::count(rows.begin(), rows.end(), 2.0), static_cast<long>(n / 2));
+	std::printf("pressure nodes %zu after the jump, at most %zu (%d new maxima); the rows' storage moved %d times\n", afterJump, largest, newMaxima,
+	            rowsMoved);
+	ASSERT_GE(newMaxima, 1) << "the count must pass its maximum for the test to show anything";
+	ASSERT_LT(largest, afterJump + afterJump / 4);
+	EXPECT_EQ(rowsMoved, 0);
 }
 
 TEST(PressureSystem, MatrixIsSymmetricWithAPositiveDiagonal)
