@@ -1027,9 +1027,9 @@ namespace stages {
 	constexpr std::size_t parallelSurfacePoints = 64;
 
 	template <class Kernel>
-	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, std::vector<WaterPointSet*>& sets, const ConstrainedNodes& constrained,
-	                   const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance,
-	                   const std::vector<char>& candidate, PressureSystem& system, std::vector<PressureSystem::NodePair>& pairs)
+	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                   const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
+	                   Real waterMassTolerance, const std::vector<char>& candidate, PressureSystem& system, std::vector<PressureSystem::NodePair>& pairs)
 	{
 		pairs.clear();
 		// a row's partners lie at offsets (−4…4)³ from it and after it in (z, y, x) order (a pair is
@@ -1067,21 +1067,33 @@ namespace stages {
 		std::vector<Real>& sampled = system.sampledSupport; // V^w_I = Σ_wp V S_I, per candidate
 		sampled.assign(candidates.size(), 0);
 		constexpr int S = Kernel::stencil;
-		// the water points whose stencil reaches a surface node, in set and point order: the pass below
-		// shares them, not all points, evenly among the threads (they gather where the surface is)
-		std::vector<std::pair<const WaterPointSet*, std::size_t>> touching;
-		for (const WaterPointSet* set : sets) {
-			const WaterPointSet& P = *set;
-			std::vector<char>    reaches(P.size(), 0);
+		// the points whose stencil reaches a surface node, the water points' in set and point order, then
+		// the wet solid points' (eq. 8.1c): the pass below shares them, not all points, evenly among the
+		// threads (they gather where the surface is)
+		struct Touching {
+			const MaterialPointSet* set;
+			std::size_t             point;
+			bool                    water;
+		};
+		std::vector<Touching> touching;
+		auto gather = [&](const MaterialPointSet& P, bool water) {
+			std::vector<char> reaches(P.size(), 0);
 #pragma omp parallel for schedule(static) if(P.size() > parallelThreshold)
 			for (std::size_t p = 0; p < P.size(); ++p) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
-				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real, const Vec3&) { reaches[p] = reaches[p] || slotOf[J] >= 0; });
+				Real wet = 0;
+				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real N, const Vec3&) {
+					reaches[p] = reaches[p] || slotOf[J] >= 0;
+					wet += N * system.skeletonWetting[J];
+				});
+				if (!water && wet < wetSolidPointFilling) reaches[p] = 0; // a dry solid point takes no part (eq. 8.1c)
 			}
 			for (std::size_t p = 0; p < P.size(); ++p)
-				if (reaches[p]) touching.emplace_back(set, p);
-		}
+				if (reaches[p]) touching.push_back(Touching { &P, p, water });
+		};
+		for (const WaterPointSet* set : sets) gather(*set, true);
+		for (const SolidSet& set : solids) gather(*set.points, false);
 		// thread 0 sums into `coupling` and `sampled`, the others into their own copies, added after in thread order
 		const int pointThreads = touching.size() <= parallelSurfacePoints ? 1 : omp_get_max_threads();
 		system.surfaceCouplingBuffers.resize(static_cast<std::size_t>(pointThreads - 1));
@@ -1098,8 +1110,9 @@ namespace stages {
 			}
 #pragma omp for schedule(static)
 			for (std::size_t k = 0; k < touching.size(); ++k) {
-				const WaterPointSet& P = *touching[k].first;
-				const std::size_t    p = touching[k].second;
+				const MaterialPointSet& P     = *touching[k].set;
+				const std::size_t       p     = touching[k].point;
+				const bool              water = touching[k].water;
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
 				std::size_t I[S * S * S];
@@ -1135,15 +1148,23 @@ namespace stages {
 					if (slotOf[I[a]] < 0) continue;
 					Coupling*  c    = mine[static_cast<std::size_t>(slotOf[I[a]])].data() + (centreSlot - place[a]);
 					const Real Na   = N[a];
-					const Real NaS  = (1 - n) * Na, NaW = n * Na;
 					const Real Da[3] = { VdN[0][a], VdN[1][a], VdN[2][a] };
+					if (!water) {
+						// the grains' share of the divergence form where eq. 8.1 takes it, at the solid
+						// points: Σ_IJ += V (1 − n) S_J ∇S_I
+						for (int b = 0; b < m; ++b)
+							for (int d = 0; d < 3; ++d) c[place[b]].surface[d] += (1 - n) * N[b] * Da[d];
+						continue;
+					}
+					const Real NaS = (1 - n) * Na, NaW = n * Na;
 					myShare[static_cast<std::size_t>(slotOf[I[a]])] += V * Na;
 					for (int b = 0; b < m; ++b) {
-						// Σ_IJ += V ∇(S_I S_J), g^s_IJ −= V (1 − n) S_I ∇S_J, g^w_IJ −= V n S_I ∇S_J (eq. 8.5e)
+						// Σ_IJ += V n ∇(S_I S_J) + V (1 − n) S_I ∇S_J (the water's share of the divergence form and
+						// the grains' of the gradient form), g^s_IJ −= V (1 − n) S_I ∇S_J, g^w_IJ −= V n S_I ∇S_J (eq. 8.5f)
 						Coupling& e = c[place[b]];
 						for (int d = 0; d < 3; ++d) {
 							const Real g = VdN[d][b];
-							e.surface[d] += N[b] * Da[d] + Na * g;
+							e.surface[d] += n * N[b] * Da[d] + Na * g;
 							e.solid[d] -= NaS * g;
 							e.water[d] -= NaW * g;
 						}
@@ -1469,9 +1490,9 @@ namespace stages {
 	                                                     Real, Real, int, PressureSystem&);                                                          \
 	template std::vector<PressureSystem::NodePair> candidateStorage<K>(const GridGeometry&, const GridFields&, const std::vector<WaterPointSet*>&, Real, \
 	                                                                   Real, const std::vector<char>&, const PressureSystem&);                         \
-	template void meniscusPairs<K>(const GridGeometry&, const GridFields&, std::vector<WaterPointSet*>&, const ConstrainedNodes&,                   \
-	                               const std::vector<std::array<bool, 3>>&, Real, Real, Real, const std::vector<char>&, PressureSystem&,          \
-	                               std::vector<PressureSystem::NodePair>&);                                                                                      \
+	template void meniscusPairs<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&,              \
+	                               const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real, const std::vector<char>&,   \
+	                               PressureSystem&, std::vector<PressureSystem::NodePair>&);                                                     \
 	template ProjectionForms projectionForms<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, std::vector<WaterPointSet*>&, \
 	                                            const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,                \
 	                                            const std::vector<Real>&, PressureSystem&);                                                          \

@@ -185,9 +185,9 @@ namespace stages {
 	// system with the walls' holds (eq. 8.8), a_J = Σ_wp V S_I ∇S_J and V^w_I = Σ_wp V S_I: summed over I into
 	// one entry per pair of rows (row ≤ column), in the order of the rows, each row's by offset.
 	template <class Kernel>
-	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, std::vector<WaterPointSet*>& sets, const ConstrainedNodes& constrained,
-	                   const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance, Real waterMassTolerance,
-	                   const std::vector<char>& candidate, PressureSystem& system, std::vector<PressureSystem::NodePair>& pairs);
+	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
+	                   const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,
+	                   Real waterMassTolerance, const std::vector<char>& candidate, PressureSystem& system, std::vector<PressureSystem::NodePair>& pairs);
 
 	// The rigid plate's column of B (theory.md eq. 2.9): b_J = Σ_wp V n D S_J + Σ_sp V (1 − n) D S_J with
 	// D = Σ_{I ∈ plate} ∂S_I/∂x_axis at the point, and c = Δt/M; K of eq. 8.7 gains c b bᵀ.

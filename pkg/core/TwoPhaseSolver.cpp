@@ -420,7 +420,17 @@ std::vector<ProjectionForms> TwoPhaseSolver::projectionFormsWith(Real dt, const 
 	using namespace stages;
 	predictForCheck<Kernel>(dt);
 	assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, pressureSystem_);
+	if (settings_.capillarySurface) { // the step's K as its first round builds it: the held nodes free, eq. 8.5f's terms in
+		std::vector<char> candidate, held;
+		capillarySurfaceSystem<Kernel>(dt, candidate, held);
+		for (std::size_t r = 0; r < held.size(); ++r)
+			if (held[r]) {
+				pressureSystem_.fixed[r] = 0;
+				if (!pressureSystem_.ghostMaster.empty()) pressureSystem_.ghostMaster[r] = -1;
+			}
+	}
 	buildPressureMatrix(grid_, pressureSystem_);
+	pressureSystem_.extraPairs.clear(); // in the matrix now; the other paths build K without them
 	std::vector<Vec3> freeNodes(static_cast<std::size_t>(pressureSystem_.matrix.rows()));
 	for (std::size_t r = 0; r < pressureSystem_.node.size(); ++r) {
 		if (pressureSystem_.fixed[r]) continue;
@@ -525,15 +535,11 @@ void TwoPhaseSolver::integrateMomentum(Real dt, bool wet, bool semiImplicit)
 	if (!constrained_.plate.empty()) moveRigidPlate(fields_, constrained_, dt, solidMassTolerance_, waterMassTolerance_, plate_); // eq. 2.9
 }
 
-// Eqs. 8.5e–f: the soil's surface nodes hold suction (free unknowns; K, positive definite, with the
-// meniscus force's surface terms) while the solve leaves the surface there at p ≤ 0; one that does not
-// becomes a seepage-face node (p = 0 at the surface: at the node, or tied as eq. 8.5b), one of those that
-// would draw water in is held again, and the system is solved again until the set no longer changes.
-template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt)
+// The capillary surface's system (eqs. 8.5e–h): which pressure rows are its candidates (`candidate`),
+// which of them the step starts holding (`held`: where the last step's active set ended), and K's surface
+// terms in pressureSystem_.extraPairs.
+template <class Kernel> void TwoPhaseSolver::capillarySurfaceSystem(Real dt, std::vector<char>& candidate, std::vector<char>& held)
 {
-	// the active set's rounds per step: each changes at least one node, and a surface has few; a set
-	// still changing after these is left as the last round had it
-	constexpr int maxSeepageRounds = 20;
 	// the least water filling V^w_I/V^full_I of a held node: a node whose support the water reaches only
 	// by the tails of its points' weights (more than a cell beyond the surface; a plane surface 0.95 h
 	// below a node fills it to 1.25e-3) has a row all but empty, and held free it leaves K near singular
@@ -549,7 +555,7 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	// wall (reached by the round-off tail of the weights only: their rows are all but empty); and a
 	// drained face's nodes above its table (eq. 8.5g): that face borders air, which gives no water, so it
 	// is a surface of the soil's water as the free one is (held in suction, released where water leaves)
-	std::vector<char> candidate(active, 0);
+	candidate.assign(active, 0);
 	for (std::size_t r = 0; r < active; ++r) {
 		const std::array<int, 3> id   = grid_.indices(sys.node[r]);
 		const Real               full = grid_.inDomainSupportVolume(id[0], id[1], id[2]);
@@ -561,7 +567,7 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	// rounds it takes to reach it (mostly one)
 	std::vector<char>& released = releasedSurface_; // per grid node
 	released.resize(grid_.nodeCount(), 0);
-	std::vector<char> held(active, 0);
+	held.assign(active, 0);
 	for (std::size_t r = 0; r < active; ++r) held[r] = candidate[r] && !released[sys.node[r]];
 	// the surface term Σ_IJ reaches the free nodes next to them too (their supports cross the surface)
 	std::vector<char> withTerms = candidate;
@@ -582,7 +588,7 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 	}
 	{
 		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.5e–f, one entry per pair of rows
-		meniscusPairs<Kernel>(grid_, fields_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, withTerms, sys, sys.extraPairs);
+		meniscusPairs<Kernel>(grid_, fields_, solids_, waters_, constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, withTerms, sys, sys.extraPairs);
 	}
 	{
 		// a candidate whose row the other candidates' explain (one water point alone reaching nodes that only
@@ -596,6 +602,23 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 		undeterminedSurfaceNodes_ += dropUndeterminedCandidates(grid_, sys, storage, heldSurfaceRank, candidate);
 		for (std::size_t r = 0; r < active; ++r) held[r] = held[r] && candidate[r];
 	}
+}
+
+// Eqs. 8.5e–f: the soil's surface nodes hold suction (free unknowns; K, positive definite, with the
+// meniscus force's surface terms) while the solve leaves the surface there at p ≤ 0; one that does not
+// becomes a seepage-face node (p = 0 at the surface: at the node, or tied as eq. 8.5b), one of those that
+// would draw water in is held again, and the system is solved again until the set no longer changes.
+template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt)
+{
+	// the active set's rounds per step: each changes at least one node, and a surface has few; a set
+	// still changing after these is left as the last round had it
+	constexpr int maxSeepageRounds = 20;
+	using namespace stages;
+	PressureSystem&   sys    = pressureSystem_;
+	const std::size_t active = sys.node.size();
+	std::vector<char> candidate, held;
+	capillarySurfaceSystem<Kernel>(dt, candidate, held);
+	std::vector<char>& released = releasedSurface_; // per grid node
 	const std::vector<char> fixed0  = sys.fixed;
 	const std::vector<Real> value0  = sys.fixedValue;
 	const std::vector<int>  master0 = sys.ghostMaster;

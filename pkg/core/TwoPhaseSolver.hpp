@@ -148,7 +148,8 @@ public:
 	// A check of the semi-implicit projection (theory.md §8.6, tests): runs the stages of a step of
 	// size dt up to the assembled system of eq. 8.7, without moving any point, and returns the
 	// compact and the exact quadratic forms for each of the given free nodal pressure fields (each
-	// sized to the free nodes; `fields(freeNodes)` builds them from the free nodes' positions).
+	// sized to the free nodes; `fields(freeNodes)` builds them from the free nodes' positions). With the
+	// capillary surface, K is the step's first round's: the held surface nodes free, eq. 8.5f's terms in.
 	std::vector<ProjectionForms> projectionForms(Real dt, const std::function<std::vector<std::vector<Real>>(const std::vector<Vec3>&)>& fields);
 	// A check of the adjointness of the pressure forces and the volume balance (theory.md eqs. 8.1–8.2,
 	// tests): maps the points as a step of size dt would (nothing moves), then for `samples` draws of a
@@ -175,6 +176,7 @@ private:
 	template <class Kernel> void mapPointsToGrid(bool wet);
 	void                         integrateMomentum(Real dt, bool wet, bool semiImplicit);
 	template <class Kernel> void projectPressure(Real dt);
+	template <class Kernel> void capillarySurfaceSystem(Real dt, std::vector<char>& candidate, std::vector<char>& held);
 	template <class Kernel> void projectWithCapillarySurface(Real dt);
 	template <class Kernel> void movePoints(Real dt);
 	template <class Kernel> void skeletonRates();

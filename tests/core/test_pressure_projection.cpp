@@ -414,8 +414,10 @@ TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionWithExtraPairsOutOfOrder) 
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionWithExtraPairsAcrossAPeriodicSeam) { expectMatrixIsThePairSum(true, true); }
 
 // The capillary surface's pairs (meniscusPairs, eq. 8.5f; PressureProjection.hpp) against their
-// definition evaluated here point by point: for each candidate node I, over the water points,
-// Σ_IJ = Σ_wp V ∇(S_I S_J), g^s_IJ = −Σ_wp V (1 − n) S_I ∇S_J, g^w_IJ = −Σ_wp V n S_I ∇S_J, V^w_I = Σ_wp V S_I;
+// definition evaluated here point by point: for each candidate node I, over the water points and the
+// wet solid points (eq. 8.1c), Σ_IJ = Σ_wp V [n S_J ∇S_I + S_I ∇S_J] + Σ_sp V (1 − n) S_J ∇S_I (the grains'
+// divergence-form share where eq. 8.1 samples it, less the gradient form's), g^s_IJ = −Σ_wp V (1 − n) S_I ∇S_J,
+// g^w_IJ = −Σ_wp V n S_I ∇S_J, V^w_I = Σ_wp V S_I;
 // per axis, f_J = (g^s_J + Σ_IJ, g^w_J) (Σ_IJ counted where it exceeds 1e-9 of I's largest: inside the
 // soil it is the points' round-off) and a_J = g^s_J + g^w_J; each pair of nodes J, K gains
 // f_Jᵀ R_I f_K − Δt λ_I a_J a_K / V^w_I, R_I the nodal response Δt M_I⁻¹ with the walls' holds (as the
@@ -431,10 +433,13 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 	const std::size_t        active = system.node.size();
 	std::vector<char>        candidate(active, 0);
 	for (std::size_t r = 0; r < active; ++r) candidate[r] = r % 2 == 0 || grid.indices(system.node[r])[2] >= 3; // inside and at the top
+	// the top plane's skeleton dry, as above a water table, so that some solid points are dry (eq. 8.1c)
+	for (std::size_t I = 0; I < grid.nodeCount(); ++I)
+		if (grid.indices(I)[2] >= 4) system.skeletonWetting[I] = 0;
 	std::vector<PressureSystem::NodePair> pairs;
 	const int                             before = omp_get_max_threads();
 	omp_set_num_threads(threads);
-	stages::meniscusPairs<GimpKernel>(grid, scene.fields, scene.waters, scene.held, scene.heldSolid, scene.dt, 1e-12, 1e-12, candidate, system, pairs);
+	stages::meniscusPairs<GimpKernel>(grid, scene.fields, scene.solids, scene.waters, scene.held, scene.heldSolid, scene.dt, 1e-12, 1e-12, candidate, system, pairs);
 	omp_set_num_threads(before);
 
 	std::map<std::pair<std::size_t, std::size_t>, Real> emitted;
@@ -449,7 +454,7 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 	for (std::size_t r = 0; r < active; ++r)
 		live[r] = !system.fixed[r] || candidate[r] || system.fixedValue[r] != 0 || (!system.ghostMaster.empty() && system.ghostMaster[r] >= 0);
 	std::map<std::pair<std::size_t, std::size_t>, Real> expected;
-	long                                                withSurface = 0;
+	long                                                withSurface = 0, wetSolidPoints = 0, drySolidPoints = 0; // point-node incidences
 	for (std::size_t r = 0; r < active; ++r) {
 		if (!candidate[r]) continue;
 		const std::size_t I = system.node[r];
@@ -479,9 +484,40 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 			supported += V * N[i];
 			for (std::size_t j = 0; j < node.size(); ++j) {
 				for (auto* sum : { &surface, &gs, &gw }) sum->try_emplace(node[j], Vec3::Zero()); // Eigen leaves a new Vec3 unset
-				surface[node[j]] += V * (dN[i] * N[j] + N[i] * dN[j]);
+				surface[node[j]] += V * (n * dN[i] * N[j] + N[i] * dN[j]);
 				gs[node[j]] -= V * (1 - n) * N[i] * dN[j];
 				gw[node[j]] -= V * n * N[i] * dN[j];
+			}
+		}
+		for (std::size_t p = 0; p < scene.solid.size(); ++p) {
+			Weights1D w[3];
+			detail::weightsAt<GimpKernel>(grid, scene.solid.position[p], scene.solid.halfLength[p], w);
+			std::vector<std::size_t> node;
+			std::vector<Real>        N;
+			std::vector<Vec3>        dN;
+			Real                     n = 0, wet = 0;
+			for (int c = 0; c < 3; ++c)
+				for (int b = 0; b < 3; ++b)
+					for (int a = 0; a < 3; ++a) {
+						node.push_back(grid.index(w[0].first + a, w[1].first + b, w[2].first + c));
+						N.push_back(w[0].value[a] * w[1].value[b] * w[2].value[c]);
+						dN.push_back(Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
+						                  w[0].value[a] * w[1].value[b] * w[2].gradient[c]));
+						n += N.back() * scene.fields.porosity[node.back()];
+						wet += N.back() * system.skeletonWetting[node.back()];
+					}
+			n             = std::clamp<Real>(n, stages::minimumInterpolatedPorosity, 1);
+			const auto at = std::find(node.begin(), node.end(), I);
+			if (at == node.end()) continue;
+			if (wet < 0.5) { // a dry solid point (eq. 8.1c)
+				++drySolidPoints;
+				continue;
+			}
+			const std::size_t i = static_cast<std::size_t>(at - node.begin());
+			++wetSolidPoints;
+			for (std::size_t j = 0; j < node.size(); ++j) {
+				for (auto* sum : { &surface, &gs, &gw }) sum->try_emplace(node[j], Vec3::Zero());
+				surface[node[j]] += scene.solid.volume[p] * (1 - n) * N[j] * dN[i];
 			}
 		}
 		Real largest = 0;
@@ -508,6 +544,8 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 			}
 	}
 	EXPECT_GT(withSurface, 20); // the top's nodes and the walls' (the box's points end 3 cm inside them)
+	EXPECT_GT(wetSolidPoints, 100); // the grains' share is sampled at the solid points
+	EXPECT_GT(drySolidPoints, 0);   // and eq. 8.1c's cut is exercised
 	Real scale = 0;
 	for (const auto& [pair, value] : expected) scale = std::max(scale, std::abs(value));
 	ASSERT_GT(scale, 0);
