@@ -177,13 +177,15 @@ namespace stages {
 	std::size_t dropUndeterminedCandidates(const GridGeometry& grid, const PressureSystem& system, const std::vector<PressureSystem::NodePair>& storage,
 	                                       Real rankTolerance, std::vector<char>& candidate);
 
-	// The surface nodes' terms of K (theory.md eqs. 8.5e–f): for each pressure node I with `candidate`
-	// set and every pair of nodes J ≤ K its water points reach, Δt [f_Jᵀ M_I⁻¹ f_K − λ_I a_J a_K/V^w_I], where
+	// The surface nodes' terms of K (theory.md eqs. 8.5e–f, 8.5i): for each pressure node I with `candidate`
+	// set and every pair of nodes J ≤ K its points reach, Δt [f_Jᵀ M_I⁻¹ f_K − λ_I a_J a_K/V^w_I], where
 	// g_J = (−Σ_wp V (1 − n) S_I ∇S_J, −Σ_wp V n S_I ∇S_J) is the force at I of a unit pressure at J in the
-	// gradient form (grains, water), f_J = g_J + (Σ_IJ, 0) adds the surface term Σ_IJ = Σ_wp V ∇(S_I S_J) on
-	// the grains (the meniscus force; zero where I's support lies inside the soil), M_I⁻¹ is the nodal 2×2
-	// system with the walls' holds (eq. 8.8), a_J = Σ_wp V S_I ∇S_J and V^w_I = Σ_wp V S_I: summed over I into
-	// one entry per pair of rows (row ≤ column), in the order of the rows, each row's by offset.
+	// gradient form (grains, water), f_J = g_J + (Σ_IJ, 0) makes the grains' part eq. 8.1's divergence form,
+	// Σ_IJ = Σ_wp V [n S_J ∇S_I + S_I ∇S_J] + Σ_sp V (1 − n) S_J ∇S_I over the water points and the wet solid
+	// points (eq. 8.1c; the meniscus force, zero where I's support lies inside the soil and both sets sample
+	// it alike), M_I⁻¹ is the nodal 2×2 system with the walls' holds (eq. 8.8), a_J = Σ_wp V S_I ∇S_J and
+	// V^w_I = Σ_wp V S_I: summed over I into one entry per pair of rows (row ≤ column), in the order of the
+	// rows, each row's by offset. Reads system.skeletonWetting (assemblePressureSystem's).
 	template <class Kernel>
 	void meniscusPairs(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, std::vector<WaterPointSet*>& sets,
 	                   const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt, Real solidMassTolerance,

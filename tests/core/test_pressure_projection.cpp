@@ -460,42 +460,16 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 		const std::size_t I = system.node[r];
 		std::map<std::size_t, Vec3> surface, gs, gw; // per node J
 		Real                        supported = 0;    // V^w_I
-		for (std::size_t p = 0; p < scene.fluid.size(); ++p) {
+		// a point's 27 nodes, weights and gradients, its interpolated porosity (clamped as the stage
+		// clamps it) and skeleton wetting (eq. 8.1c); returns the place of I among its nodes, or −1
+		std::vector<std::size_t> node;
+		std::vector<Real>        N;
+		std::vector<Vec3>        dN;
+		Real                     n = 0, wet = 0;
+		auto                     stencil = [&](const Vec3& x, const Vec3& halfLength) {
 			Weights1D w[3];
-			detail::weightsAt<GimpKernel>(grid, scene.fluid.position[p], scene.fluid.halfLength[p], w);
-			std::vector<std::size_t> node;
-			std::vector<Real>        N;
-			std::vector<Vec3>        dN;
-			Real                     n = 0;
-			for (int c = 0; c < 3; ++c)
-				for (int b = 0; b < 3; ++b)
-					for (int a = 0; a < 3; ++a) {
-						node.push_back(grid.index(w[0].first + a, w[1].first + b, w[2].first + c));
-						N.push_back(w[0].value[a] * w[1].value[b] * w[2].value[c]);
-						dN.push_back(Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
-						                  w[0].value[a] * w[1].value[b] * w[2].gradient[c]));
-						n += N.back() * scene.fields.porosity[node.back()];
-					}
-			n = std::clamp<Real>(n, stages::minimumInterpolatedPorosity, 1);
-			const auto at = std::find(node.begin(), node.end(), I);
-			if (at == node.end()) continue;
-			const std::size_t i = static_cast<std::size_t>(at - node.begin());
-			const Real        V = scene.fluid.volume[p];
-			supported += V * N[i];
-			for (std::size_t j = 0; j < node.size(); ++j) {
-				for (auto* sum : { &surface, &gs, &gw }) sum->try_emplace(node[j], Vec3::Zero()); // Eigen leaves a new Vec3 unset
-				surface[node[j]] += V * (n * dN[i] * N[j] + N[i] * dN[j]);
-				gs[node[j]] -= V * (1 - n) * N[i] * dN[j];
-				gw[node[j]] -= V * n * N[i] * dN[j];
-			}
-		}
-		for (std::size_t p = 0; p < scene.solid.size(); ++p) {
-			Weights1D w[3];
-			detail::weightsAt<GimpKernel>(grid, scene.solid.position[p], scene.solid.halfLength[p], w);
-			std::vector<std::size_t> node;
-			std::vector<Real>        N;
-			std::vector<Vec3>        dN;
-			Real                     n = 0, wet = 0;
+			detail::weightsAt<GimpKernel>(grid, x, halfLength, w);
+			node.clear(), N.clear(), dN.clear(), n = 0, wet = 0;
 			for (int c = 0; c < 3; ++c)
 				for (int b = 0; b < 3; ++b)
 					for (int a = 0; a < 3; ++a) {
@@ -508,12 +482,27 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 					}
 			n             = std::clamp<Real>(n, stages::minimumInterpolatedPorosity, 1);
 			const auto at = std::find(node.begin(), node.end(), I);
-			if (at == node.end()) continue;
+			return at == node.end() ? -1 : static_cast<int>(at - node.begin());
+		};
+		for (std::size_t p = 0; p < scene.fluid.size(); ++p) {
+			const int i = stencil(scene.fluid.position[p], scene.fluid.halfLength[p]);
+			if (i < 0) continue;
+			const Real V = scene.fluid.volume[p];
+			supported += V * N[i];
+			for (std::size_t j = 0; j < node.size(); ++j) {
+				for (auto* sum : { &surface, &gs, &gw }) sum->try_emplace(node[j], Vec3::Zero()); // Eigen leaves a new Vec3 unset
+				surface[node[j]] += V * (n * dN[i] * N[j] + N[i] * dN[j]);
+				gs[node[j]] -= V * (1 - n) * N[i] * dN[j];
+				gw[node[j]] -= V * n * N[i] * dN[j];
+			}
+		}
+		for (std::size_t p = 0; p < scene.solid.size(); ++p) {
+			const int i = stencil(scene.solid.position[p], scene.solid.halfLength[p]);
+			if (i < 0) continue;
 			if (wet < 0.5) { // a dry solid point (eq. 8.1c)
 				++drySolidPoints;
 				continue;
 			}
-			const std::size_t i = static_cast<std::size_t>(at - node.begin());
 			++wetSolidPoints;
 			for (std::size_t j = 0; j < node.size(); ++j) {
 				for (auto* sum : { &surface, &gs, &gw }) sum->try_emplace(node[j], Vec3::Zero());
