@@ -12,14 +12,16 @@
 #              Cost knobs, find α costs no accuracy at equal Δt/α). Both modes spill the reservoir over the crest once
 #              the history's head reaches the ground at the inflow face (the example's default, --spill-at-ground: from
 #              ≈ 54 s the crest has subsided below the head, which the flume's reservoir cannot hold; held there with
-#              --no-spill-at-ground the full run meets a step-size instability of the capillary surface at 57 s,
-#              doc/sandpile.md Full mode, doc/theory.md §8 Open);
-#              PILE_FULL_MAX_WALL_TIME [s] ends it at a record, the figures of the time reached)
+#              --no-spill-at-ground the full run met an instability of the capillary surface at 57-60 s, gone since
+#              theory.md eq. 8.5i: doc/sandpile.md Full mode);
+#              PILE_FULL_MAX_WALL_TIME [s] ends it at a record, the figures of the time reached;
+#              PILE_THREADS the runs' threads, default 2: doc/'s pile figures are drawn with PILE_THREADS=1)
 #   pile-full  the full pile alone (its figures; the quick ones untouched)
 # Each pile run's summary.json is copied next to its figures, so that doc/ states which run drew them.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${MPM_BUILD_DIR:-$root/build}"
+threads="${PILE_THREADS:-2}" # the pile runs' threads (yade -j): the figures in doc/ are drawn on one (PILE_THREADS=1), which is bit-reproducible
 parts=()
 full=0
 for arg in "$@"; do
@@ -42,7 +44,7 @@ run_pile() {
   shift
   local out="$work/$name"
   echo "== sand pile '$name': examples/sandpile/sandpile.py $*"
-  PYTHONPATH="$build/python" HOME="$work" yade-double -j2 -n -x "$root/examples/sandpile/sandpile.py" "$@" --out "$out" > "$work/$name.log" 2>&1 \
+  PYTHONPATH="$build/python" HOME="$work" yade-double -j"$threads" -n -x "$root/examples/sandpile/sandpile.py" "$@" --out "$out" > "$work/$name.log" 2>&1 \
     || { tail -40 "$work/$name.log"; exit 1; }
   for figure in pore_pressure velocity_at_failure shear_band runout time_series; do
     cp "$out/$figure.png" "$figures/sandpile_${name}_$figure.png"
