@@ -1018,8 +1018,9 @@ namespace stages {
 		}
 	}
 
-	// Σ_IJ below this share of node I's largest counts as round-off (eq. 8.5e): the sum over points of
-	// ∇(S_I S_J) over a support inside the soil cancels to the points' quadrature error
+	// Σ_IJ below this share of node I's largest counts as round-off (eq. 8.5e): over a support inside the
+	// soil the water points' n ∇(S_I S_J) + (1 − n) S_I ∇S_J and the solid points' (1 − n) S_J ∇S_I cancel to
+	// round-off where both sets sample it alike (eq. 8.5i), and to their quadratures' difference elsewhere
 	constexpr Real surfaceShareTolerance = 1e-9;
 	// meniscusPairs shares its surface nodes among the threads from this many on (one costs ≈ 40 µs)
 	constexpr std::size_t parallelSurfaceNodes = 8;
@@ -1085,7 +1086,7 @@ namespace stages {
 				Real wet = 0;
 				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real N, const Vec3&) {
 					reaches[p] = reaches[p] || slotOf[J] >= 0;
-					wet += N * system.skeletonWetting[J];
+					if (!water) wet += N * system.skeletonWetting[J];
 				});
 				if (!water && wet < wetSolidPointFilling) reaches[p] = 0; // a dry solid point takes no part (eq. 8.1c)
 			}
@@ -1201,7 +1202,7 @@ namespace stages {
 			const std::size_t        I   = system.node[r];
 			const std::array<int, 3> idx = grid.indices(I);
 			// the surface term of a node J whose product support with I lies inside the soil is round-off
-			// (Σ_IJ → 0); the pairs of such nodes keep the gradient form's part
+			// where both point sets sample it alike (Σ_IJ → 0); the pairs of such nodes keep the gradient form's part
 			Real largest = 0;
 			for (int o = 0; o < 125; ++o) largest = std::max(largest, coupling[c][o].surface.norm());
 			if (!(largest > 0)) return;

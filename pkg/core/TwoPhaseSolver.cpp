@@ -422,7 +422,9 @@ std::vector<ProjectionForms> TwoPhaseSolver::projectionFormsWith(Real dt, const 
 	assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, pressureSystem_);
 	if (settings_.capillarySurface) { // the step's K as its first round builds it: the held nodes free, eq. 8.5f's terms in
 		std::vector<char> candidate, held;
+		const long        undetermined = undeterminedSurfaceNodes_; // a check leaves the run's count as it was
 		capillarySurfaceSystem<Kernel>(dt, candidate, held);
+		undeterminedSurfaceNodes_ = undetermined;
 		for (std::size_t r = 0; r < held.size(); ++r)
 			if (held[r]) {
 				pressureSystem_.fixed[r] = 0;

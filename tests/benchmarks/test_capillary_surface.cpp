@@ -260,7 +260,6 @@ TEST(CapillarySurface, APointCutAtAnInflowFaceAboveItsTableLosesOnlyTheCut)
 	EXPECT_NEAR(c.solver->removedWaterMass(), cut, tolerance);
 }
 
-// The semi-implicit step with the capillary surface under gravity g along −z.
 // The projection's stability bound at a surface node that the grains reach far more than the water
 // (theory.md §8 Open, the held-head sand pile's event). After a correction the volume residual is
 // (I − A K⁻¹) times the last one, A = BᵀM⁻¹B the exact form of eq. 8.1, so the projection is stable
@@ -322,6 +321,7 @@ TEST(CapillarySurface, ProjectionBoundHoldsWhereTheGrainsReachASurfaceNodeFarMor
 	EXPECT_LT(worst, 1);
 }
 
+// The semi-implicit step with the capillary surface under gravity g along −z.
 SolverSettings capillarySettings(double g)
 {
 	SolverSettings settings;

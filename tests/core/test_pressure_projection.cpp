@@ -419,7 +419,7 @@ TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionWithExtraPairsAcrossAPerio
 // divergence-form share where eq. 8.1 samples it, less the gradient form's), g^s_IJ = −Σ_wp V (1 − n) S_I ∇S_J,
 // g^w_IJ = −Σ_wp V n S_I ∇S_J, V^w_I = Σ_wp V S_I;
 // per axis, f_J = (g^s_J + Σ_IJ, g^w_J) (Σ_IJ counted where it exceeds 1e-9 of I's largest: inside the
-// soil it is the points' round-off) and a_J = g^s_J + g^w_J; each pair of nodes J, K gains
+// soil, where both sets sample alike, it is the points' round-off) and a_J = g^s_J + g^w_J; each pair of nodes J, K gains
 // f_Jᵀ R_I f_K − Δt λ_I a_J a_K / V^w_I, R_I the nodal response Δt M_I⁻¹ with the walls' holds (as the
 // stage leaves it in system.grainResponse / waterResponse: the corrector's, tested there). Pairs with a
 // row fixed at p = 0 that is no candidate, tied to nothing, add exactly zero to what is solved and are
