@@ -1067,7 +1067,7 @@ namespace stages {
 		for (auto& c : coupling) c.fill(Coupling {});
 		std::vector<Real>& sampled = system.sampledSupport; // V^w_I = Σ_wp V S_I, per candidate
 		sampled.assign(candidates.size(), 0);
-		constexpr int S = Kernel::stencil;
+		constexpr int S = Kernel::stencil, S3 = S * S * S;
 		// the points whose stencil reaches a surface node, the water points' in set and point order, then
 		// the wet solid points' (eq. 8.1c): the pass below shares them, not all points, evenly among the
 		// threads (they gather where the surface is)
@@ -1083,18 +1083,39 @@ namespace stages {
 			for (std::size_t p = 0; p < P.size(); ++p) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
-				Real wet = 0;
-				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real N, const Vec3&) {
-					reaches[p] = reaches[p] || slotOf[J] >= 0;
-					if (!water) wet += N * system.skeletonWetting[J];
-				});
-				if (!water && wet < wetSolidPointFilling) reaches[p] = 0; // a dry solid point takes no part (eq. 8.1c)
+				// the nodes forEachNode visits (all but those with S = 0 and ∂S/∂x = 0): a point that reaches a
+				// candidate only at a zero node adds exact zeros below, but keeps its place in the threads' shares
+				int node[3][S];
+				stencilNodes(grid, w, node);
+				bool reached = false;
+				Real wet     = 0;
+				for (int c = 0; c < S; ++c)
+					for (int b = 0; b < S; ++b) {
+						const std::size_t row = grid.index(0, node[1][b], node[2][c]);
+						const Real        vyz = w[1].value[b] * w[2].value[c];
+						for (int a = 0; a < S; ++a) {
+							const Real N = w[0].value[a] * vyz;
+							if (N == 0 && w[0].gradient[a] == 0) continue;
+							const std::size_t J = row + static_cast<std::size_t>(node[0][a]);
+							reached             = reached || slotOf[J] >= 0;
+							if (!water) wet += N * system.skeletonWetting[J];
+						}
+					}
+				reaches[p] = reached && (water || wet >= wetSolidPointFilling); // a dry solid point takes no part (eq. 8.1c)
 			}
 			for (std::size_t p = 0; p < P.size(); ++p)
 				if (reaches[p]) touching.push_back(Touching { &P, p, water });
 		};
 		for (const WaterPointSet* set : sets) gather(*set, true);
 		for (const SolidSet& set : solids) gather(*set.points, false);
+		// the rows a pair must join to count: a free row, one the active set may free (`candidate`), one tied
+		// to a free master (eq. 8.5b) or one held at p̄ ≠ 0. A pair with any other row, fixed at p = 0 and
+		// untied in every round, adds exactly zero to K, to the right-hand side and to the excess of the rows the
+		// active set reads (rowExcess): dropping it changes no bit and leaves a fraction of the pairs (a
+		// surface's outer rows are fixed)
+		std::vector<char> live(active, 0);
+		for (std::size_t r = 0; r < active; ++r)
+			live[r] = !system.fixed[r] || candidate[r] || system.fixedValue[r] != 0 || (!system.ghostMaster.empty() && system.ghostMaster[r] >= 0);
 		// thread 0 sums into `coupling` and `sampled`, the others into their own copies, added after in thread order
 		const int pointThreads = touching.size() <= parallelSurfacePoints ? 1 : omp_get_max_threads();
 		system.surfaceCouplingBuffers.resize(static_cast<std::size_t>(pointThreads - 1));
@@ -1116,56 +1137,73 @@ namespace stages {
 				const bool              water = touching[k].water;
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
-				std::size_t I[S * S * S];
-				Real        N[S * S * S];
-				Vec3        dN[S * S * S];
-				int         m       = 0;
-				Real        n       = 0;
-				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real NJ, const Vec3& dNJ) {
-					I[m] = J, N[m] = NJ, dN[m] = dNJ, ++m;
-					n += NJ * fields.porosity[J];
-				});
-				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
-				const Real V = P.volume[p];
-				// each node's place in the 5³ box of offsets, relative to the first node: a pair's slot is
-				// centreSlot + place[b] − place[a] while the stencil spans at most 3 nodes per axis; one
-				// wrapped across a periodic axis would not (the capillary surface refuses periodic axes at
-				// setup, TwoPhaseSolver), and such a point is skipped
-				const std::array<int, 3> first = grid.indices(I[0]);
-				int                      place[S * S * S], low[3] = { 0, 0, 0 }, high[3] = { 0, 0, 0 };
-				for (int a = 0; a < m; ++a) {
-					const std::array<int, 3> at = grid.indices(I[a]);
-					int                      d3[3];
-					for (int d = 0; d < 3; ++d) d3[d] = at[d] - first[d], low[d] = std::min(low[d], d3[d]), high[d] = std::max(high[d], d3[d]);
-					place[a] = d3[0] + 5 * d3[1] + 25 * d3[2];
+				// the stencil's nodes in (z, y, x) order with their places in the 5³ box of offsets (x + 5 y + 25 z
+				// from the stencil's first node: a pair's slot is centreSlot + place[b] − place[a]), less an end
+				// node whose weight and gradient along its axis are zero (forEachNode skips it: it adds exact
+				// zeros). A stencil wrapped across a periodic axis would not fit the box (the capillary surface
+				// refuses periodic axes at setup, TwoPhaseSolver), and such a point is skipped
+				int node[3][S], lo[3], hi[3];
+				stencilNodes(grid, w, node);
+				bool wraps = false;
+				for (int d = 0; d < 3; ++d) {
+					for (int a = 1; a < S; ++a) wraps = wraps || node[d][a] != node[d][0] + a;
+					lo[d] = w[d].value[0] == 0 && w[d].gradient[0] == 0 ? 1 : 0;
+					hi[d] = w[d].value[S - 1] == 0 && w[d].gradient[S - 1] == 0 ? S - 2 : S - 1;
 				}
-				const bool compact = high[0] - low[0] <= 2 && high[1] - low[1] <= 2 && high[2] - low[2] <= 2;
-				if (!compact) continue;
-				// the point's terms, V S_J and V ∇S_J, as plain arrays: the pair loop below is the stage's hot loop
-				Real VdN[3][S * S * S];
-				for (int b = 0; b < m; ++b)
-					for (int d = 0; d < 3; ++d) VdN[d][b] = V * dN[b][d];
+				if (wraps) continue;
+				const Real V = P.volume[p];
+				std::size_t I[S3];
+				int         place[S3];
+				Real        N[S3], VdN[3][S3]; // S_J and V ∇S_J as plain arrays: the pair loop below is the stage's hot loop
+				bool        keeps[S3];         // J's g^s_IJ and g^w_IJ are read (a live row, below)
+				Real        n = 0;
+				int         m = 0;
+				for (int c = lo[2]; c <= hi[2]; ++c)
+					for (int b = lo[1]; b <= hi[1]; ++b) {
+						const Real        vyz = w[1].value[b] * w[2].value[c], gyz = w[1].gradient[b] * w[2].value[c], vygz = w[1].value[b] * w[2].gradient[c];
+						const std::size_t row = grid.index(0, node[1][b], node[2][c]);
+						for (int a = lo[0]; a <= hi[0]; ++a, ++m) {
+							I[m]      = row + static_cast<std::size_t>(node[0][a]);
+							place[m]  = a + 5 * b + 25 * c;
+							N[m]      = w[0].value[a] * vyz;
+							VdN[0][m] = V * (w[0].gradient[a] * vyz);
+							VdN[1][m] = V * (w[0].value[a] * gyz);
+							VdN[2][m] = V * (w[0].value[a] * vygz);
+							n += N[m] * fields.porosity[I[m]];
+						}
+					}
+				n = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
+				for (int b = 0; b < m; ++b) {
+					const int row = system.row[I[b]];
+					keeps[b]      = row >= 0 && live[static_cast<std::size_t>(row)];
+				}
 				for (int a = 0; a < m; ++a) {
-					if (slotOf[I[a]] < 0) continue;
-					Coupling*  c    = mine[static_cast<std::size_t>(slotOf[I[a]])].data() + (centreSlot - place[a]);
-					const Real Na   = N[a];
+					const int slot = slotOf[I[a]];
+					if (slot < 0) continue;
+					Coupling*  c     = mine[static_cast<std::size_t>(slot)].data() + (centreSlot - place[a]);
+					const Real Na    = N[a];
 					const Real Da[3] = { VdN[0][a], VdN[1][a], VdN[2][a] };
 					if (!water) {
 						// the grains' share of the divergence form where eq. 8.1 takes it, at the solid
 						// points: Σ_IJ += V (1 − n) S_J ∇S_I
-						for (int b = 0; b < m; ++b)
-							for (int d = 0; d < 3; ++d) c[place[b]].surface[d] += (1 - n) * N[b] * Da[d];
+						for (int b = 0; b < m; ++b) {
+							const Real sN = (1 - n) * N[b];
+							for (int d = 0; d < 3; ++d) c[place[b]].surface[d] += sN * Da[d];
+						}
 						continue;
 					}
 					const Real NaS = (1 - n) * Na, NaW = n * Na;
-					myShare[static_cast<std::size_t>(slotOf[I[a]])] += V * Na;
+					myShare[static_cast<std::size_t>(slot)] += V * Na;
 					for (int b = 0; b < m; ++b) {
 						// Σ_IJ += V n ∇(S_I S_J) + V (1 − n) S_I ∇S_J (the water's share of the divergence form and
-						// the grains' of the gradient form), g^s_IJ −= V (1 − n) S_I ∇S_J, g^w_IJ −= V n S_I ∇S_J (eq. 8.5f)
-						Coupling& e = c[place[b]];
+						// the grains' of the gradient form), g^s_IJ −= V (1 − n) S_I ∇S_J, g^w_IJ −= V n S_I ∇S_J (eq. 8.5f);
+						// Σ_IJ at every J (node I's largest is its scale), g^s_IJ and g^w_IJ only where read
+						Coupling&  e  = c[place[b]];
+						const Real nN = n * N[b];
+						for (int d = 0; d < 3; ++d) e.surface[d] += nN * Da[d] + Na * VdN[d][b];
+						if (!keeps[b]) continue;
 						for (int d = 0; d < 3; ++d) {
 							const Real g = VdN[d][b];
-							e.surface[d] += n * N[b] * Da[d] + Na * g;
 							e.solid[d] -= NaS * g;
 							e.water[d] -= NaW * g;
 						}
@@ -1185,14 +1223,6 @@ namespace stages {
 				}
 			}
 		}
-		// the rows a pair must join to count: a free row, one the active set may free (`candidate`), one tied
-		// to a free master (eq. 8.5b) or one held at p̄ ≠ 0. A pair with any other row, fixed at p = 0 and
-		// untied in every round, adds exactly zero to K, to the right-hand side and to the excess of the rows the
-		// active set reads (rowExcess): dropping it changes no bit and leaves a fraction of the pairs (a
-		// surface's outer rows are fixed)
-		std::vector<char> live(active, 0);
-		for (std::size_t r = 0; r < active; ++r)
-			live[r] = !system.fixed[r] || candidate[r] || system.fixedValue[r] != 0 || (!system.ghostMaster.empty() && system.ghostMaster[r] >= 0);
 		// eq. 8.5f per candidate I: node I's share of K becomes L_I − Δt λ_I a aᵀ/V^w_I + F_Iᵀ R_I F_I (a
 		// covariance and a Gram matrix: K positive definite by construction), i.e. L plus, per pair (J, K),
 		// value = Σ_d u_K,dᵀ Z_d u_J,d with u_J,d = (Σ_IJ where it counts, g^s_IJ, g^w_IJ) along axis d and
@@ -1211,6 +1241,7 @@ namespace stages {
 			// order and the box around I does not wrap), so a pair's first node always has the smaller row
 			int rowOf[125], code[125], m = 0;
 			alignas(64) Real u[9][125];
+			alignas(64) Real pairValue[125];
 			for (int o = 0; o < 125; ++o) {
 				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, cc = o / 25 - 2;
 				const int x = idx[0] + a, y = idx[1] + b, z = idx[2] + cc;
@@ -1245,12 +1276,14 @@ namespace stages {
 					if (blocks.size() < used * blockSlots) blocks.resize(used * blockSlots, 0); // kept zero between steps: grown only
 				}
 				Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots - code[x];
-				// one pass per pair: its nine terms summed in registers, then added to the row's block
+				// each pair's nine terms summed in order (a loop over the pairs the compiler vectorises),
+				// then added to the row's block
 				for (int y = x; y < m; ++y) {
 					Real value = 0;
 					for (int e = 0; e < 9; ++e) value += u[e][y] * zu[e];
-					block[code[y]] += value; // code[y] ≥ code[x]: offset order
+					pairValue[y] = value;
 				}
+				for (int y = x; y < m; ++y) block[code[y]] += pairValue[y]; // code[y] ≥ code[x]: offset order
 			}
 		};
 		// the candidates split among the threads, each summing into its own blocks; then summed in thread order
