@@ -260,28 +260,16 @@ TEST(CapillarySurface, APointCutAtAnInflowFaceAboveItsTableLosesOnlyTheCut)
 	EXPECT_NEAR(c.solver->removedWaterMass(), cut, tolerance);
 }
 
-// The projection's stability bound at a surface node that the grains reach far more than the water
-// (theory.md §8 Open, the held-head sand pile's event). After a correction the volume residual is
-// (I − A K⁻¹) times the last one, A = BᵀM⁻¹B the exact form of eq. 8.1, so the projection is stable
-// only while pᵀAp ≤ 2 pᵀKp for every nodal p; the project keeps pᵀAp ≤ pᵀKp (L ⪰ A inside the soil,
-// §8.6). The capillary column's grains end 0.625 h below the node plane at its top, its water
-// 0.875 h below: that node, filled by the water to 0.8% of its support and by the grains to 7%, is held
-// (a candidate of eq. 8.5e, free), and the solid points between the two surfaces are wet (eq. 8.1c:
-// the node below is full). Their share of the mixture's divergence form pulls on that node's light
-// skeleton; eq. 8.5f's bracket took that share sampled at the water points, which reach the node by
-// the tails of their weights only: the linear pressure field gave pᵀAp/pᵀKp = 1.52 (a unit pressure at
-// that node 0.33, at the node below 0.71; at the pile's node 2.8). With the share sampled where eq. 8.1
-// takes it, at the wet solid points (eq. 8.5f), K at a node with terms holds that node's exact share
-// plus the covariance L_I − Δt a Λ_I aᵀ/V^w_I ⪰ 0, which vanishes on a linear field: measured 0.98
-// (0.27, 0.56), the equality at the nodes with terms, L's margin elsewhere. Checked on the step's
-// first-round K (held nodes free) for a unit pressure at each free node, 20 random fields and the
-// linear one. (The linear kernel gives the same numbers here: no point of this lattice straddles a node.)
-TEST(CapillarySurface, ProjectionBoundHoldsWhereTheGrainsReachASurfaceNodeFarMoreThanTheWater)
+// pᵀAp/pᵀKp of the step's first-round K (held nodes free) for a unit pressure at each free node, 20
+// random fields and the linear one z: the worst, the worst of the unit pressures at the nodes of the plane z
+// = plane, and whether that plane has free rows.
+struct ProjectionQuotients {
+	double worst = 0, onThePlane = 0;
+	bool   planeFree = false;
+	std::size_t freeNodes = 0;
+};
+ProjectionQuotients projectionQuotients(CapillaryColumn& c, double plane)
 {
-	const int       perCell = 8; // points per cell and axis: the surfaces at multiples of h/8
-	const double    h       = CapillaryColumn::cell, top = CapillaryColumn::height;
-	CapillaryColumn c(true, 0, top - 0.625 * h, perCell);
-	c.fluid = fixtures::waterLattice(fixtures::lattice(Vec3::Zero(), Vec3(h, h, top - 0.875 * h), h, perCell), c.soil.porosity, c.water.density);
 	c.solver = std::make_unique<TwoPhaseSolver>(c.domain, c.settings);
 	c.solver->setPoints({ SolidSet { &c.solid, c.soil, false, SkeletonModel::LinearElastic, StrengthParameters {} } }, { &c.fluid }, c.water);
 	const double dt     = 0.5 * c.solver->timeStepLimits().critical;
@@ -309,17 +297,69 @@ TEST(CapillarySurface, ProjectionBoundHoldsWhereTheGrainsReachASurfaceNodeFarMor
 		fields.push_back(linear);
 		return fields;
 	});
-	double worst = 0, atTheNode = 0;
-	bool   held  = false; // the top node plane is among the free rows
+	ProjectionQuotients q;
+	q.freeNodes = at.size();
 	for (std::size_t f = 0; f < forms.size(); ++f) {
-		ASSERT_GT(forms[f].compact, 0);
-		worst = std::max(worst, forms[f].exact / forms[f].compact);
-		if (f < at.size() && std::abs(at[f].z() - top) < 1e-9) held = true, atTheNode = std::max(atTheNode, forms[f].exact / forms[f].compact);
+		EXPECT_GT(forms[f].compact, 0);
+		q.worst = std::max(q.worst, forms[f].exact / forms[f].compact);
+		if (f < at.size() && std::abs(at[f].z() - plane) < 1e-9) q.planeFree = true, q.onThePlane = std::max(q.onThePlane, forms[f].exact / forms[f].compact);
 	}
-	std::printf("%zu free nodes, pᵀAp/pᵀKp at the top node %.3f, worst %.3f\n", at.size(), atTheNode, worst);
-	EXPECT_TRUE(held) << "the node the grains reach more than the water must be a held surface node";
-	EXPECT_LT(worst, 1);
+	return q;
 }
+
+// The projection's stability bound at a surface node that the grains reach far more than the water
+// (theory.md §8 Open, the held-head sand pile's event). After a correction the volume residual is
+// (I − A K⁻¹) times the last one, A = BᵀM⁻¹B the exact form of eq. 8.1, so the projection is stable
+// only while pᵀAp ≤ 2 pᵀKp for every nodal p; the project keeps pᵀAp ≤ pᵀKp (L ⪰ A inside the soil,
+// §8.6). The capillary column's grains end 0.625 h below the node plane at its top, its water
+// 0.875 h below: that node, filled by the water to 0.8% of its support and by the grains to 7%, is held
+// (a candidate of eq. 8.5e, free), and the solid points between the two surfaces are wet (eq. 8.1c:
+// the node below is full). Their share of the mixture's divergence form pulls on that node's light
+// skeleton; eq. 8.5f's bracket took that share sampled at the water points, which reach the node by
+// the tails of their weights only: the linear pressure field gave pᵀAp/pᵀKp = 1.52 (a unit pressure at
+// that node 0.33, at the node below 0.71; at the pile's node 2.8). With the share sampled where eq. 8.1
+// takes it, at the wet solid points (eq. 8.5f), K at a node with terms holds that node's exact share
+// plus the covariance L_I − Δt a Λ_I aᵀ/V^w_I ⪰ 0, which vanishes on a linear field: measured 0.98
+// (0.27, 0.56), the equality at the nodes with terms, L's margin elsewhere. Checked on the step's
+// first-round K (held nodes free) for a unit pressure at each free node, 20 random fields and the
+// linear one. (The linear kernel gives the same numbers here: no point of this lattice straddles a node.)
+TEST(CapillarySurface, ProjectionBoundHoldsWhereTheGrainsReachASurfaceNodeFarMoreThanTheWater)
+{
+	const int       perCell = 8; // points per cell and axis: the surfaces at multiples of h/8
+	const double    h       = CapillaryColumn::cell, top = CapillaryColumn::height;
+	CapillaryColumn c(true, 0, top - 0.625 * h, perCell);
+	c.fluid = fixtures::waterLattice(fixtures::lattice(Vec3::Zero(), Vec3(h, h, top - 0.875 * h), h, perCell), c.soil.porosity, c.water.density);
+	const ProjectionQuotients q = projectionQuotients(c, top);
+	std::printf("%zu free nodes, pᵀAp/pᵀKp at the top node %.3f, worst %.3f\n", q.freeNodes, q.onThePlane, q.worst);
+	EXPECT_TRUE(q.planeFree) << "the node the grains reach more than the water must be a held surface node";
+	EXPECT_LT(q.worst, 1);
+}
+
+// The water's surface on a node plane under a layer of wet grains δ thick (theory.md eq. 8.5i's last
+// paragraph): that plane's nodes are half filled and held; the plane above, which the water does not
+// reach, is fixed at p = 0 and has no row, and the wet solid points below it pull on its light skeleton
+// when the pressures below change. Its share of A = BᵀM⁻¹B has no term in K (eq. 8.5f gives terms to the
+// candidates only), so the project's margin pᵀAp ≤ pᵀKp is not met here: measured 1.48, 1.53 and 1.01 at
+// δ = h/8, h/4 and h/2 (a unit pressure on the held plane 1.03, 0.98, 0.58). The excess is the fixed plane's
+// share: a probe of the same geometry at 20 points per cell with every fixed node's work left out of A gave
+// 0.79–0.93 (twenty-seventh stop). What is asserted is the projection's stability,
+// pᵀAp < 2 pᵀKp (the volume residual after a correction is (I − A K⁻¹) times the last one), with the
+// excess over 1 an open item of theory.md §8, not a margin this test grants.
+class WaterSurfaceOnANodePlane : public ::testing::TestWithParam<int> {};
+
+TEST_P(WaterSurfaceOnANodePlane, ProjectionStaysWithinItsStabilityBound)
+{
+	const int       perCell = 8, eighths = GetParam(); // the wet grains' layer δ = eighths h/8 above the water
+	const double    h = CapillaryColumn::cell, top = CapillaryColumn::height, plane = top - h;
+	CapillaryColumn c(true, 0, plane + eighths * h / perCell, perCell);
+	c.fluid = fixtures::waterLattice(fixtures::lattice(Vec3::Zero(), Vec3(h, h, plane), h, perCell), c.soil.porosity, c.water.density);
+	const ProjectionQuotients q = projectionQuotients(c, plane);
+	std::printf("grains %d/8 h above the water on a node plane: %zu free nodes, pᵀAp/pᵀKp on that plane %.3f, worst %.3f\n", eighths, q.freeNodes, q.onThePlane,
+	            q.worst);
+	EXPECT_TRUE(q.planeFree) << "the water surface's node plane is held";
+	EXPECT_LT(q.worst, 2);
+}
+INSTANTIATE_TEST_SUITE_P(CapillarySurface, WaterSurfaceOnANodePlane, ::testing::Values(1, 2, 4));
 
 // The semi-implicit step with the capillary surface under gravity g along −z.
 SolverSettings capillarySettings(double g)
