@@ -1033,9 +1033,6 @@ namespace stages {
 	                   Real waterMassTolerance, const std::vector<char>& candidate, PressureSystem& system, std::vector<PressureSystem::NodePair>& pairs)
 	{
 		pairs.clear();
-		// a row's partners lie at offsets (−4…4)³ from it and after it in (z, y, x) order (a pair is
-		// stored on its first row): in base 9 with digits −4…4, the offsets 0…364
-		constexpr int blockSlots = (9 * 9 * 9 + 1) / 2;
 		const std::size_t nodes = grid.nodeCount(), active = system.node.size();
 		// the nodal response Δt M⁻¹ per axis (with the walls' holds) to a unit force on the grains and on the water
 		std::vector<Vec3>& ss = system.grainResponse[0];
@@ -1116,6 +1113,21 @@ namespace stages {
 		std::vector<char> live(active, 0);
 		for (std::size_t r = 0; r < active; ++r)
 			live[r] = !system.fixed[r] || candidate[r] || system.fixedValue[r] != 0 || (!system.ghostMaster.empty() && system.ghostMaster[r] >= 0);
+		// a row's partners lie at offsets (−R…R) from it per axis, R_d ≤ 4 (both in a candidate's 5³ box) and
+		// at most the live rows' extent along d (one node in a one-cell flume), and after it in (z, y, x) order (a
+		// pair is stored on its first row): with the mixed radix W_d = 2 R_d + 1 and digits −R_d…R_d, the
+		// offsets 0…(W_x W_y W_z − 1)/2 — a smaller block where the live rows are thin along an axis
+		int radius[3], width[3];
+		{
+			int low[3] = { grid.nodes[0], grid.nodes[1], grid.nodes[2] }, high[3] = { -1, -1, -1 };
+			for (std::size_t r = 0; r < active; ++r) {
+				if (!live[r]) continue;
+				const std::array<int, 3> at = grid.indices(system.node[r]);
+				for (int d = 0; d < 3; ++d) low[d] = std::min(low[d], at[d]), high[d] = std::max(high[d], at[d]);
+			}
+			for (int d = 0; d < 3; ++d) radius[d] = std::clamp(high[d] - low[d], 0, 4), width[d] = 2 * radius[d] + 1;
+		}
+		const int blockSlots = (width[0] * width[1] * width[2] + 1) / 2;
 		// thread 0 sums into `coupling` and `sampled`, the others into their own copies, added after in thread order
 		const int pointThreads = touching.size() <= parallelSurfacePoints ? 1 : omp_get_max_threads();
 		system.surfaceCouplingBuffers.resize(static_cast<std::size_t>(pointThreads - 1));
@@ -1251,7 +1263,7 @@ namespace stages {
 				const Coupling& J       = coupling[c][o];
 				const bool      counts  = J.surface.norm() > negligible;
 				rowOf[m]                = row;
-				code[m]                 = (o / 25) * 81 + ((o / 5) % 5) * 9 + o % 5; // the offset in base 9
+				code[m]                 = ((o / 25) * width[1] + (o / 5) % 5) * width[0] + o % 5; // the offset + (2, 2, 2) in the radix W
 				for (int d = 0; d < 3; ++d) u[3 * d][m] = counts ? J.surface[d] : 0, u[3 * d + 1][m] = J.solid[d], u[3 * d + 2][m] = J.water[d];
 				++m;
 			}
@@ -1302,10 +1314,11 @@ namespace stages {
 		}
 		// each row's pairs: its blocks summed in thread order (the sums do not depend on which threads
 		// reached the row: 0 + x = x), each slot zeroed as it is read so the blocks start the next step zero
-		std::array<long, blockSlots> step; // a slot's offset as a step in grid-node index
+		std::vector<long> step(static_cast<std::size_t>(blockSlots)); // a slot's offset as a step in grid-node index
 		for (int slot = 0; slot < blockSlots; ++slot) {
-			const int o = slot + blockSlots - 1; // the offset + (4, 4, 4) in base 9, digits 0…8
-			step[slot]  = (o % 9 - 4) + static_cast<long>(grid.nodes[0]) * ((o / 9) % 9 - 4 + static_cast<long>(grid.nodes[1]) * (o / 81 - 4));
+			const int o = slot + blockSlots - 1; // the offset + R in the radix W, digits 0…2 R_d
+			step[static_cast<std::size_t>(slot)] = (o % width[0] - radius[0])
+			                                      + static_cast<long>(grid.nodes[0]) * ((o / width[0]) % width[1] - radius[1] + static_cast<long>(grid.nodes[1]) * (o / (width[0] * width[1]) - radius[2]));
 		}
 		// the rows with blocks, shared evenly among the threads, each emitting into its own list; the
 		// lists joined in thread order keep the pairs in row order
@@ -1335,7 +1348,7 @@ namespace stages {
 				for (int slot = 0; slot < blockSlots; ++slot) {
 					Real value = 0;
 					for (int q = 0; q < count; ++q) value += reached[static_cast<std::size_t>(q)][slot], reached[static_cast<std::size_t>(q)][slot] = 0;
-					if (value != 0) mine.push_back(PressureSystem::NodePair { a, static_cast<std::size_t>(system.row[static_cast<std::size_t>(I + step[slot])]), value });
+					if (value != 0) mine.push_back(PressureSystem::NodePair { a, static_cast<std::size_t>(system.row[static_cast<std::size_t>(I + step[static_cast<std::size_t>(slot)])]), value });
 				}
 			}
 		}
