@@ -1080,25 +1080,12 @@ namespace stages {
 			for (std::size_t p = 0; p < P.size(); ++p) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
-				// the nodes forEachNode visits (all but those with S = 0 and ∂S/∂x = 0): a point that reaches a
-				// candidate only at a zero node adds exact zeros below, but keeps its place in the threads' shares
-				int node[3][S];
-				stencilNodes(grid, w, node);
-				bool reached = false;
-				Real wet     = 0;
-				for (int c = 0; c < S; ++c)
-					for (int b = 0; b < S; ++b) {
-						const std::size_t row = grid.index(0, node[1][b], node[2][c]);
-						const Real        vyz = w[1].value[b] * w[2].value[c];
-						for (int a = 0; a < S; ++a) {
-							const Real N = w[0].value[a] * vyz;
-							if (N == 0 && w[0].gradient[a] == 0) continue;
-							const std::size_t J = row + static_cast<std::size_t>(node[0][a]);
-							reached             = reached || slotOf[J] >= 0;
-							if (!water) wet += N * system.skeletonWetting[J];
-						}
-					}
-				reaches[p] = reached && (water || wet >= wetSolidPointFilling); // a dry solid point takes no part (eq. 8.1c)
+				Real wet = 0;
+				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real N, const Vec3&) {
+					reaches[p] = reaches[p] || slotOf[J] >= 0;
+					if (!water) wet += N * system.skeletonWetting[J];
+				});
+				if (!water && wet < wetSolidPointFilling) reaches[p] = 0; // a dry solid point takes no part (eq. 8.1c)
 			}
 			for (std::size_t p = 0; p < P.size(); ++p)
 				if (reaches[p]) touching.push_back(Touching { &P, p, water });
