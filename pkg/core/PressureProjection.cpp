@@ -1101,7 +1101,7 @@ namespace stages {
 		for (std::size_t r = 0; r < active; ++r)
 			live[r] = !system.fixed[r] || candidate[r] || system.fixedValue[r] != 0 || (!system.ghostMaster.empty() && system.ghostMaster[r] >= 0);
 		// a row's partners lie at offsets (−R…R) from it per axis, R_d ≤ 4 (both in a candidate's 5³ box) and
-		// at most the live rows' extent along d (one node in a one-cell flume), and after it in (z, y, x) order (a
+		// at most the live rows' extent along d (three in the one-cell flume: its wall planes and the padding beyond), and after it in (z, y, x) order (a
 		// pair is stored on its first row): with the mixed radix W_d = 2 R_d + 1 and digits −R_d…R_d, the
 		// offsets 0…(W_x W_y W_z − 1)/2 — a smaller block where the live rows are thin along an axis
 		int radius[3], width[3];

@@ -254,15 +254,14 @@ struct RandomPressureScene {
 	std::vector<std::array<bool, 3>> heldSolid;
 	PressureSystem                   system;
 
-	// `width`: the box's extent along y [m] (one cell: a slab whose rows span two node planes in y)
-	explicit RandomPressureScene(bool periodicX, Real width = 0.3)
-	    : grid(GridGeometry::forDomain(Vec3::Zero(), Vec3(0.3, width, 0.4), h, { periodicX, false, false }))
+	explicit RandomPressureScene(bool periodicX)
+	    : grid(GridGeometry::forDomain(Vec3::Zero(), Vec3(0.3, 0.3, 0.4), h, { periodicX, false, false }))
 	{
 		fields.resize(grid.nodeCount());
 		// the predicted velocities the right-hand side reads (the predictor's, not run here): at rest
 		std::fill(fields.solidVelocityNew.begin(), fields.solidVelocityNew.end(), Vec3::Zero());
 		std::fill(fields.waterVelocityNew.begin(), fields.waterVelocityNew.end(), Vec3::Zero());
-		std::uniform_real_distribution<Real> ux(periodicX ? 0.0 : 0.03, periodicX ? 0.3 : 0.27), uy(0.03, width - 0.03), uz(0.03, 0.33), len(0.015, 0.025);
+		std::uniform_real_distribution<Real> ux(periodicX ? 0.0 : 0.03, periodicX ? 0.3 : 0.27), uy(0.03, 0.27), uz(0.03, 0.33), len(0.015, 0.025);
 		solid.resize(400);
 		fluid.resize(400);
 		for (std::size_t p = 0; p < solid.size(); ++p) {
@@ -425,10 +424,12 @@ TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionWithExtraPairsAcrossAPerio
 // stage leaves it in system.grainResponse / waterResponse: the corrector's, tested there). Pairs with a
 // row fixed at p = 0 that is no candidate, tied to nothing, add exactly zero to what is solved and are
 // left out by both. The stage's slots, thread buffers and emission must give the same sums, one entry
-// per pair of rows (row ≤ column) in row order, with one thread and with two.
-void expectMeniscusPairsAreTheirDefinition(int threads, Real width = 0.3, long minimumChecked = 1000)
+// per pair of rows (row ≤ column) in row order, with one thread and with two. The box's live rows span
+// 3, 5, 5 nodes, so the stage's row blocks hold offsets in the radix (7, 9, 9), not the full 9³ (the slots
+// coded in base 9 instead fail here).
+void expectMeniscusPairsAreTheirDefinition(int threads)
 {
-	RandomPressureScene      scene(false, width);
+	RandomPressureScene      scene(false);
 	const GridGeometry&      grid   = scene.grid;
 	PressureSystem&          system = scene.system;
 	const std::size_t        active = system.node.size();
@@ -547,16 +548,12 @@ void expectMeniscusPairsAreTheirDefinition(int threads, Real width = 0.3, long m
 		checked += std::abs(value) > 1e-6 * scale;
 	}
 	for (const auto& [pair, value] : emitted) EXPECT_TRUE(expected.count(pair)) << "a pair the definition has not: rows " << pair.first << ", " << pair.second;
-	EXPECT_GT(checked, minimumChecked);
+	EXPECT_GT(checked, 1000);
 	std::printf("%ld candidate nodes with surface terms, %zu pairs, %ld of them above 1e-6 of the largest\n", withSurface, pairs.size(), checked);
 }
 
 TEST(CapillarySurfacePairs, AreTheirDefinitionOnOneThread) { expectMeniscusPairsAreTheirDefinition(1); }
 TEST(CapillarySurfacePairs, AreTheirDefinitionOnTwoThreads) { expectMeniscusPairsAreTheirDefinition(2); }
-// A slab one cell thick (as the plane-strain sand pile's flume): the live rows span fewer offsets along y,
-// and the stage's row blocks hold only those (fewer slots, another radix for the offsets); measured 32
-// candidates with terms, 820 pairs, 763 above 1e-6 of the largest
-TEST(CapillarySurfacePairs, AreTheirDefinitionInASlabOneCellThick) { expectMeniscusPairsAreTheirDefinition(2, RandomPressureScene::h, 500); }
 
 // Eqs. 8.5b and 8.5d: a surface that slopes across the grid. Free water fills a box below the plane
 // z = z0 + x tan γx + y tan γy (water points on a lattice of m per cell and axis, kept where the centre
