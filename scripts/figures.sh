@@ -5,7 +5,7 @@
 #   compare    scripts/compare.sh: doc/compare/ (MPM against DEM + PFV), doc/tradeoffs.md and
 #              doc/figures/tradeoffs.* (20-40 min; see that script for reusing stored runs)
 #   pile       examples/sandpile/sandpile.py, quick mode (h = 2 cm):
-#              the main job's scene (yade_mpm.sandpile.DEFAULT, laboratory history): doc/figures/sandpile_quick_* (8 min);
+#              the main job's scene (yade_mpm.sandpile.DEFAULT, laboratory history): doc/figures/sandpile_quick_* (8-10 min on one thread);
 #              with --full also the same scene at h = 1 cm with α held (--inertia-release inf):
 #              doc/figures/sandpile_full_* (50 min on two threads, 42 min on one, 2300-4500 CPU s). α is held because released at 26-27 s the
 #              true inertia's step would make it 6-7 h (the step-error measurements on the quick pile, doc/sandpile.md
@@ -15,13 +15,14 @@
 #              --no-spill-at-ground the full run met an instability of the capillary surface at 57-60 s, gone since
 #              theory.md eq. 8.5i: doc/sandpile.md Full mode);
 #              PILE_FULL_MAX_WALL_TIME [s] ends it at a record, the figures of the time reached;
-#              PILE_THREADS the runs' threads, default 2: doc/'s pile figures are drawn with PILE_THREADS=1)
+#              PILE_THREADS the runs' threads, default 1: one thread is bit-reproducible and drew doc/'s pile figures;
+#              two change the answers by round-off grown through the slide, doc/sandpile.md)
 #   pile-full  the full pile alone (its figures; the quick ones untouched)
 # Each pile run's summary.json is copied next to its figures, so that doc/ states which run drew them.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${MPM_BUILD_DIR:-$root/build}"
-threads="${PILE_THREADS:-2}" # the pile runs' threads (yade -j): the figures in doc/ are drawn on one (PILE_THREADS=1), which is bit-reproducible
+threads="${PILE_THREADS:-1}" # the pile runs' threads (yade -j): one, as doc/'s figures were drawn (bit-reproducible)
 parts=()
 full=0
 for arg in "$@"; do
