@@ -26,6 +26,17 @@ import os
 import numpy as np
 
 
+_LINKS = ((1, 0), (-1, 0), (0, 1), (0, -1))  # a node's neighbours (Δi, Δj), in the order of its link weights
+
+
+def _shifted(a, di, dj):
+    """a's value at (i + di, j + dj) for every node (i, j); zero (False) beyond the grid."""
+    out = np.zeros_like(a)
+    out[max(-di, 0):a.shape[0] - max(di, 0), max(-dj, 0):a.shape[1] - max(dj, 0)] = a[max(di, 0):a.shape[0] + min(di, 0) or None,
+                                                                                      max(dj, 0):a.shape[1] + min(dj, 0) or None]
+    return out
+
+
 class SteadySeepage:
     """The steady head on a grid of `spacing` [m]; see the module's docstring for the problem.
 
@@ -41,7 +52,7 @@ class SteadySeepage:
             raise ValueError("inflow_head = %r m is outside the valid range [0, inf)" % inflow_head)
         if spacing > min(length, height) / 4:
             raise ValueError("spacing = %r m is outside the valid range (0, %g] (four cells across the section)" % (spacing, min(length, height) / 4))
-        self.spacing, self.inflow_head, self.outflow_head = float(spacing), float(inflow_head), outflow_head
+        self.spacing = float(spacing)
         nx, nz = int(round(length / spacing)), int(round(height / spacing))
         self.nx, self.nz = nx, nz
         x, z = np.arange(nx + 1) * spacing, np.arange(nz + 1) * spacing
@@ -49,12 +60,7 @@ class SteadySeepage:
         inside = Z <= np.asarray(surface(X), dtype=float) + 1e-12
         self.inside = inside
 
-        def neighbour(a, di, dj):  # a's value at (i + di, j + dj), False beyond the grid
-            out = np.zeros_like(a)
-            out[max(-di, 0):a.shape[0] - max(di, 0), max(-dj, 0):a.shape[1] - max(dj, 0)] = a[max(di, 0):a.shape[0] + min(di, 0) or None, max(dj, 0):a.shape[1] + min(dj, 0) or None]
-            return out
-
-        east, west, north, south = (neighbour(inside, 1, 0), neighbour(inside, -1, 0), neighbour(inside, 0, 1), neighbour(inside, 0, -1))
+        east, west, north = _shifted(inside, 1, 0), _shifted(inside, -1, 0), _shifted(inside, 0, 1)
         fixed = inside & (X == 0) & (Z < inflow_head - 1e-12)
         if outflow_head is not None:
             fixed |= inside & (np.arange(nx + 1)[:, None] == nx)
@@ -68,9 +74,9 @@ class SteadySeepage:
         lower, upper = np.maximum(z - 0.5 * spacing, 0)[None, :], (z + 0.5 * spacing)[None, :]
         east_link = np.clip(np.minimum(s_mid, upper) - lower, 0, None) / spacing * (inside[:-1, :] & inside[1:, :])
         samples = (np.arange(16) + 0.5) / 16  # across a face between rows j and j + 1, per column
-        xs = np.clip(x[:, None] + (samples[None, :] - 0.5) * spacing, 0, length)
-        span = np.where((x[:, None] + (samples[None, :] - 0.5) * spacing >= 0) & (x[:, None] + (samples[None, :] - 0.5) * spacing <= length), 1.0, 0.0)
-        s_across = np.asarray(surface(xs), dtype=float)
+        across = x[:, None] + (samples[None, :] - 0.5) * spacing
+        span = (across >= 0) & (across <= length)
+        s_across = np.asarray(surface(np.clip(across, 0, length)), dtype=float)
         z_mid = (np.arange(nz) + 0.5) * spacing
         north_link = (span[:, :, None] * (s_across[:, :, None] >= z_mid[None, None, :])).mean(axis=1) * (inside[:, :-1] & inside[:, 1:])
         w_east, w_west, w_north, w_south = (np.zeros((nx + 1, nz + 1)) for _ in range(4))
@@ -86,13 +92,12 @@ class SteadySeepage:
         head = np.where(obstacle, np.minimum(head, Z), head)
         colour = np.add.outer(np.arange(nx + 1), np.arange(nz + 1)) % 2
         omega = 2 / (1 + math.sin(math.pi / max(nx, nz)))
-        shifts = [(1, 0), (-1, 0), (0, 1), (0, -1)]
         self.sweeps = 0
         for sweep in range(max_sweeps):
             change = 0.0
             for c in (0, 1):
                 mask = free & (colour == c)
-                mean = sum(w * neighbour(head, di, dj) for w, (di, dj) in zip(weights, shifts)) / np.where(total > 0, total, 1)
+                mean = sum(w * _shifted(head, di, dj) for w, (di, dj) in zip(weights, _LINKS)) / np.where(total > 0, total, 1)
                 new = head + omega * (mean - head)
                 new = np.where(obstacle, np.minimum(new, Z), new)
                 if mask.any():
@@ -123,11 +128,7 @@ class SteadySeepage:
         neighbours: positive where the reservoir feeds the section, negative where water leaves it (the
         seepage face, a held outflow face), zero at free nodes to the solver's tolerance."""
         h = self.head
-        out = np.zeros_like(h)
-        for w, (di, dj) in zip(self._weights, [(1, 0), (-1, 0), (0, 1), (0, -1)]):
-            shifted = np.zeros_like(h)
-            shifted[max(-di, 0):h.shape[0] - max(di, 0), max(-dj, 0):h.shape[1] - max(dj, 0)] = h[max(di, 0):h.shape[0] + min(di, 0) or None, max(dj, 0):h.shape[1] + min(dj, 0) or None]
-            out += conductivity * w * (h - shifted)
+        out = sum(conductivity * w * (h - _shifted(h, di, dj)) for w, (di, dj) in zip(self._weights, _LINKS))
         return np.where(self.inside, out, 0.0)
 
     def _reservoir(self):
