@@ -89,6 +89,89 @@ namespace {
 			}
 	}
 
+	// The local projection stabilisation of eq. 8.6b at one point: G_J = ∇S_J(x_p) − ∇N_J(x_c), the
+	// gradient of node J's weight at the point less that of its trilinear hat at the centre x_c of the
+	// point's cell (zero off the cell's eight nodes), so that Σ_J G_J p_J is the part of the point's
+	// pressure gradient that departs from the cell's mean one: zero for any linear nodal field. Returns
+	// false where the cell's nodes are not all in the stencil (a point off the grid's cells).
+	template <int S>
+	inline bool fluctuationGradients(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const Vec3 (&dN)[S][S][S], Vec3 (&G)[S][S][S],
+	                                 int (&cellCorner)[3])
+	{
+		for (int d = 0; d < 3; ++d) {
+			cellCorner[d] = static_cast<int>(std::floor((position[d] - grid.origin[d]) / grid.cellSize)) - w[d].first;
+			if (cellCorner[d] < 0 || cellCorner[d] + 1 >= S) return false;
+		}
+		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
+		for (int c = 0; c < S; ++c)
+			for (int b = 0; b < S; ++b)
+				for (int a = 0; a < S; ++a) {
+					G[c][b][a]   = dN[c][b][a];
+					const int i = a - cellCorner[0], j = b - cellCorner[1], k = c - cellCorner[2];
+					if (i >= 0 && i <= 1 && j >= 0 && j <= 1 && k >= 0 && k <= 1) G[c][b][a] -= centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
+				}
+		return true;
+	}
+
+	// Eq. 8.6b's S at one point beyond the ∇S_J·∇S_K part that addPairTerms adds with the conductance:
+	// weight × (G_J·G_K − ∇S_J·∇S_K) for the pairs with a node of the point's cell (the others' is zero),
+	// in the stored upper half of the rows.
+	template <int S>
+	inline void addFluctuationPairs(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const int (&node)[3][S], const Vec3 (&dN)[S][S][S],
+	                                Real weight, const PressureSystem& system, Real* rows)
+	{
+		Vec3 G[S][S][S];
+		int  corner[3];
+		if (!fluctuationGradients<S>(grid, position, w, dN, G, corner)) return;
+		auto inCell = [&](int a, int b, int c) { return a - corner[0] >= 0 && a - corner[0] <= 1 && b - corner[1] >= 0 && b - corner[1] <= 1 && c - corner[2] >= 0 && c - corner[2] <= 1; };
+		for (int c = 0; c < S; ++c)
+			for (int b = 0; b < S; ++b)
+				for (int a = 0; a < S; ++a) {
+					const int rowJ = system.row[grid.index(node[0][a], node[1][b], node[2][c])];
+					if (rowJ < 0) continue;
+					const bool cellJ = inCell(a, b, c);
+					Real*      r     = rows + static_cast<std::size_t>(rowJ) * PressureSystem::rowStride;
+					for (int cc = c; cc < S; ++cc)
+						for (int bb = cc == c ? b : 0; bb < S; ++bb)
+							for (int aa = cc == c && bb == b ? a : 0; aa < S; ++aa) {
+								if (!cellJ && !inCell(aa, bb, cc)) continue;
+								if (system.row[grid.index(node[0][aa], node[1][bb], node[2][cc])] < 0) continue;
+								r[upperSlot(aa - a, bb - b, cc - c)] += weight * (G[c][b][a].dot(G[cc][bb][aa]) - dN[c][b][a].dot(dN[cc][bb][aa]));
+							}
+				}
+	}
+
+	// (S q)_J of eq. 8.6b at one water point of volume V: V c κ/μw G_J·Σ_K G_K q_K, added to the rows
+	// (q per grid node, c κ/μw interpolated from system.darcyConductance).
+	template <int S>
+	inline void addFluctuationBalance(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], Real V, const std::vector<Real>& q,
+	                                  const PressureSystem& system, Real* rows)
+	{
+		int  node[3][S];
+		Vec3 dN[S][S][S], G[S][S][S];
+		stencilNodes(grid, w, node);
+		Real darcy = 0;
+		for (int c = 0; c < S; ++c)
+			for (int b = 0; b < S; ++b)
+				for (int a = 0; a < S; ++a) {
+					dN[c][b][a] = Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
+					                   w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
+					darcy += w[0].value[a] * w[1].value[b] * w[2].value[c] * system.darcyConductance[grid.index(node[0][a], node[1][b], node[2][c])];
+				}
+		int corner[3];
+		if (!(darcy > 0) || !fluctuationGradients<S>(grid, position, w, dN, G, corner)) return;
+		Vec3 g = Vec3::Zero();
+		for (int c = 0; c < S; ++c)
+			for (int b = 0; b < S; ++b)
+				for (int a = 0; a < S; ++a) g += q[grid.index(node[0][a], node[1][b], node[2][c])] * G[c][b][a];
+		for (int c = 0; c < S; ++c)
+			for (int b = 0; b < S; ++b)
+				for (int a = 0; a < S; ++a) {
+					const int r = system.row[grid.index(node[0][a], node[1][b], node[2][c])];
+					if (r >= 0) rows[r] += V * darcy * G[c][b][a].dot(g);
+				}
+	}
+
 	// The filling from which a solid point counts as wet (theory.md eq. 8.1c): the interpolation
 	// Σ S_I min(1, V^w_I/V_I) at the point (PressureSystem::skeletonWetting) at least one half — what it
 	// is, about, at a point on a plane water table (a node on the table is half filled), so the points
@@ -342,7 +425,7 @@ namespace stages {
 	template <class Kernel>
 	void assemblePressureSystem(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, const std::vector<WaterPointSet*>& sets,
 	                            const WaterParameters& water, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
-	                            Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system)
+	                            Real solidMassTolerance, Real waterMassTolerance, Real darcyStabilisation, PressureSystem& system)
 	{
 		constexpr int S = Kernel::stencil;
 		const Real    rhoWater = water.density;
@@ -359,6 +442,19 @@ namespace stages {
 			const Real perWater = hasS ? 1 / fields.dragSupport[I] : 1;
 			system.mobility[I]  = Vec3::Constant(hasS ? pressureMobility(fields.porosity[I], perWater * sn.mass / sn.solidVolume, rhoWater, perWater * sn.drag * dt / sn.volume)
 			                                          : 1 / rhoWater);
+		}
+		// eq. 8.6b: c κ/μw = c n²/Q̂ per node with the skeleton's drag (Q̂ = n²μw/κ per unit of the
+		// water-sampled support, as in eq. 8.5c); none in free water, which has no Darcy flux
+		system.darcyConductance.assign(nodes, 0);
+		const bool stabilised = darcyStabilisation > 0;
+		if (stabilised) {
+#pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
+			for (std::size_t I = 0; I < nodes; ++I) {
+				const SolidNode& sn = fields.solid[I];
+				if (!(sn.mass > solidMassTolerance && sn.solidVolume > 0 && sn.volume > 0 && sn.drag > 0)) continue;
+				const Real n              = fields.porosity[I];
+				system.darcyConductance[I] = darcyStabilisation * n * n * sn.volume * fields.dragSupport[I] / sn.drag;
+			}
 		}
 		for (std::size_t c = 0; c < constrained.node.size(); ++c) {
 			const std::size_t     I  = constrained.node[c];
@@ -407,7 +503,7 @@ namespace stages {
 				stencilNodes(grid, w, node);
 				// the porosity and mobility at the water point (eqs. 4.5, 8.5), the divergence of the
 				// predicted skeleton (mixture) velocity and the relative velocity w = vw − vs
-				Real n = 0, divMixture = 0;
+				Real n = 0, divMixture = 0, darcy = 0;
 				Vec3 lambda = Vec3::Zero(), relative = Vec3::Zero();
 				Real N[S][S][S];
 				Vec3 dN[S][S][S];
@@ -421,6 +517,7 @@ namespace stages {
 							const Real        Ni = N[c][b][a];
 							n += Ni * fields.porosity[I];
 							lambda += Ni * system.mobility[I];
+							if (stabilised) darcy += Ni * system.darcyConductance[I];
 							divMixture += system.mixtureVelocity[I].dot(dN[c][b][a]);
 							relative += Ni * system.relativeVelocity[I];
 						}
@@ -432,7 +529,9 @@ namespace stages {
 				const Vec3 relativeFlux = n * relative;
 				const Real divergence   = n * divMixture;
 				const Real storage    = waterPointStorage(V, n, invKw, dt); // consistent: Σ V S_J S_K n/(Kw Δt)
-				const Vec3 conductance = dt * V * lambda;    // Δt L (eq. 8.6), per axis
+				// Δt L (eq. 8.6), per axis, and the ∇S_J·∇S_K part of eq. 8.6b's S, whose remainder follows
+				Vec3 conductance = dt * V * lambda;
+				if (darcy > 0) conductance += Vec3::Constant(V * darcy);
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n
 				for (int c = 0; c < S; ++c)
 					for (int b = 0; b < S; ++b)
@@ -442,6 +541,7 @@ namespace stages {
 							     PressureSystem::rhsSlot] += N[c][b][a] * (stored - V * divergence) + V * relativeFlux.dot(dN[c][b][a]);
 						}
 				addPairTerms<S>(grid, w, node, storage, conductance, system, rows);
+				if (darcy > 0) addFluctuationPairs<S>(grid, P.position[p], w, node, dN, V * darcy, system, rows);
 			});
 		}
 		// the solid's share of the volume balance, (1 − n)∇·vs − vs·∇n, at the solid points (eq. 8.2):
@@ -1379,7 +1479,7 @@ namespace stages {
 		PressureWork     work;
 		WaterParameters  noStorage = water;
 		noStorage.bulkModulus      = std::numeric_limits<Real>::infinity(); // C = 0: b = −Bᵀv
-		assemblePressureSystem<Kernel>(grid, fields, solids, sets, noStorage, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, system);
+		assemblePressureSystem<Kernel>(grid, fields, solids, sets, noStorage, constrained, heldSolid, dt, solidMassTolerance, waterMassTolerance, 0, system);
 		for (std::size_t r = 0; r < system.node.size(); ++r)
 			work.balance -= pressure[system.node[r]] * system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
 		accumulatePressureForces<Kernel>(grid, fields, solids, sets, pressure, false, system);
@@ -1417,6 +1517,7 @@ namespace stages {
 		std::vector<Real>                      balance;
 		std::vector<std::vector<Real>>         balanceBuffers;
 		Eigen::Matrix<Real, Eigen::Dynamic, 1> residual(n), step(n);
+		const bool stabilised = std::any_of(system.darcyConductance.begin(), system.darcyConductance.end(), [](Real c) { return c > 0; });
 		for (int k = 0; k < corrections; ++k) {
 			const std::vector<Real>& q = system.nodalPressure;
 			// δ(q) = Δt M⁻¹ (B q + the faces' traction), walls held, the plate moved by c (b·q): the
@@ -1461,6 +1562,7 @@ namespace stages {
 					forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {
 						if (system.row[I] >= 0) rows[system.row[I]] += N * V * (nn * invKw / dt * qp + nn * div) - V * nn * rel.dot(dN);
 					});
+					if (stabilised) addFluctuationBalance<Kernel::stencil>(grid, P.position[p], w, V, q, system, rows); // S q (eq. 8.6b)
 				});
 			}
 			for (const SolidSet& set : solids) {
@@ -1510,7 +1612,7 @@ namespace stages {
 	template void classifyPressureNodes<K>(const GridGeometry&, const GridFields&, const std::vector<WaterPointSet*>&, const BoundaryConditions&, \
 	                                       const Vec3&, Real, PressureSystem&);                                                         \
 	template void assemblePressureSystem<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, const std::vector<WaterPointSet*>&, \
-	                                        const WaterParameters&, const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real,  \
+	                                        const WaterParameters&, const ConstrainedNodes&, const std::vector<std::array<bool, 3>>&, Real, Real, Real, Real, \
 	                                        PressureSystem&);                                                                                     \
 	template void assemblePlateCoupling<K>(const GridGeometry&, const GridFields&, const std::vector<SolidSet>&, const std::vector<WaterPointSet*>&, \
 	                                       const ConstrainedNodes&, const PlateMotion&, Real, PressureSystem&);                           \

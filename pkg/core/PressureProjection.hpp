@@ -82,6 +82,7 @@ struct PressureSystem {
 	std::vector<std::vector<Real>> rowBuffers; // per extra thread
 	std::vector<Real>        nodalPressure;   // per grid node: p^{n+1}, 0 off the pressure nodes [Pa]
 	std::vector<Vec3>        mobility;        // per grid node and axis: λ of eq. 8.5 with the walls' holds [m³ kg⁻¹]
+	std::vector<Real>        darcyConductance; // per grid node: c κ/μw of eq. 8.6b where the skeleton has mass, else 0 [m² Pa⁻¹ s⁻¹]
 	std::vector<Real>        skeletonShare;      // per grid node: θ = min(1, V_I/V^w_I), 1 without water, 0 without skeleton (eq. 8.1) [-]
 	std::vector<Real>        skeletonWetting;    // per grid node: min(1, V^w_I/V_I), 0 without skeleton (eq. 8.1c) [-]
 	std::vector<Vec3>        solidPointVelocity; // per grid node: v*^s where the skeleton has mass, else v*^w (eq. 8.2) [m s⁻¹]
@@ -143,15 +144,16 @@ namespace stages {
 	void classifyPressureNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
 	                           const Vec3& gravity, Real waterDensity, PressureSystem& system);
 
-	// K = C/Δt + Δt L and b = C p^n/Δt − Bᵀ v* of eq. 8.7 at the pressure nodes, by one pass over
-	// the water points (eqs. 8.2, 8.3, 8.5, 8.6), with the predicted nodal velocities v* of both
+	// K = C/Δt + Δt L + S and b = C p^n/Δt − Bᵀ v* of eq. 8.7 at the pressure nodes, by one pass over
+	// the water points (eqs. 8.2, 8.3, 8.5, 8.6, 8.6b), with the predicted nodal velocities v* of both
 	// phases and the points' pressures p^n. The mobility λ of eq. 8.5 is taken per node and axis,
 	// with the phases held by walls (`heldSolid`, the water constraints) out of its 2×2 system, and
-	// interpolated to the points.
+	// interpolated to the points. S is the local projection stabilisation of eq. 8.6b with the factor
+	// `darcyStabilisation` c (0: none).
 	template <class Kernel>
 	void assemblePressureSystem(const GridGeometry& grid, const GridFields& fields, const std::vector<SolidSet>& solids, const std::vector<WaterPointSet*>& sets,
 	                            const WaterParameters& water, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
-	                            Real solidMassTolerance, Real waterMassTolerance, PressureSystem& system);
+	                            Real solidMassTolerance, Real waterMassTolerance, Real darcyStabilisation, PressureSystem& system);
 
 	// b − K p per pressure node from the stored rows and system.nodalPressure (every node's row, fixed
 	// or free, the plate's rank-one term left out): zero on a free row at convergence; on a prescribed
@@ -211,7 +213,8 @@ namespace stages {
 	PressureSolveReport solvePressure(PressureSystem& system, Real tolerance);
 
 	// Defect correction towards the exact projection (theory.md §8.7b): `corrections` times,
-	// p ← p + K⁻¹ [b − (C p/Δt + Bᵀ δ(p))] with δ(p) the corrector's velocity increments for p
+	// p ← p + K⁻¹ [b − (C p/Δt + Bᵀ δ(p) + S p)] with δ(p) the corrector's velocity increments for p
+	// and S the stabilisation of eq. 8.6b (system.darcyConductance, assemblePressureSystem's)
 	// (walls held, the plate moved), applied matrix-free. It converges because 0 ⪯ A ⪯ L
 	// (`projectionForms`): the iteration matrix I − K⁻¹K_A has its eigenvalues in [0, 1). Each
 	// correction costs three passes over the points and one solve. Returns the solves' report.

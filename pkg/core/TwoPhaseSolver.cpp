@@ -32,6 +32,9 @@ namespace {
 	constexpr double inflowBufferTolerance = 1e-9;
 	// More defect corrections per step than this buy nothing the discretisation keeps (theory.md §8.7b).
 	constexpr long maxPressureCorrections = 20;
+	// eq. 8.6b's factor beyond which the stabilisation would outweigh the Darcy flux it stands for by an
+	// order of magnitude: a value above it is a typing error, not a choice
+	constexpr Real maxDarcyStabilisation = 10;
 	// A water point reaching past a drained face by less than this share of its length is not cut
 	// (round-off, e.g. a column at rest), and one with less than it left inside leaves whole
 	// (theory.md eq. 2.4).
@@ -118,6 +121,7 @@ void SolverSettings::validate() const
 	if (!gravity.allFinite()) throw InvalidParameter("gravity must have finite components [m s⁻²]");
 	requireOpenRange("pressureTolerance", pressureTolerance, 0, inf, "Pa");
 	if (!(pressureCorrections >= 0 && pressureCorrections <= maxPressureCorrections)) throwOutOfRange("pressureCorrections", pressureCorrections, "", "[0, " + std::to_string(maxPressureCorrections) + "]");
+	if (!(darcyStabilisation >= 0 && darcyStabilisation <= maxDarcyStabilisation)) throwOutOfRange("darcyStabilisation", darcyStabilisation, "", "[0, " + std::to_string(static_cast<int>(maxDarcyStabilisation)) + "]");
 	if (!(maxSubSteps >= 1)) throwOutOfRange("maxSubSteps", maxSubSteps, "", "[1, inf)");
 	if (!(inertiaScale >= 1 && std::isfinite(inertiaScale))) throwOutOfRange("inertiaScale", inertiaScale, "", "[1, inf)");
 	if (!(inertiaScaleRelease > 0)) throwOutOfRange("inertiaScaleRelease", inertiaScaleRelease, "", "(0, inf]");
@@ -419,7 +423,8 @@ std::vector<ProjectionForms> TwoPhaseSolver::projectionFormsWith(Real dt, const 
 {
 	using namespace stages;
 	predictForCheck<Kernel>(dt);
-	assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_, pressureSystem_);
+	assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
+	                               settings_.darcyStabilisation, pressureSystem_);
 	if (settings_.capillarySurface) { // the step's K as its first round builds it: the held nodes free, eq. 8.5f's terms in
 		std::vector<char> candidate, held;
 		const long        undetermined = undeterminedSurfaceNodes_; // a check leaves the run's count as it was
@@ -692,7 +697,7 @@ template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
 		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.1–8.7
 		classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, pressureSystem_);
 		assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
-		                               pressureSystem_);
+		                               settings_.darcyStabilisation, pressureSystem_);
 		if (!constrained_.plate.empty()) assemblePlateCoupling<Kernel>(grid_, fields_, solids_, waters_, constrained_, plate_, dt, pressureSystem_);
 		else pressureSystem_.plateCoupling.clear();
 		if (!settings_.capillarySurface) buildPressureMatrix(grid_, pressureSystem_);

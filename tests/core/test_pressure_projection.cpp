@@ -301,7 +301,7 @@ struct RandomPressureScene {
 		}
 		held.positionOf.assign(grid.nodeCount(), -1); // as ConstrainedNodes::build leaves it
 		for (std::size_t c = 0; c < held.node.size(); ++c) held.positionOf[held.node[c]] = static_cast<int>(c);
-		stages::assemblePressureSystem<GimpKernel>(grid, fields, solids, waters, water, held, heldSolid, dt, 1e-12, 1e-12, system);
+		stages::assemblePressureSystem<GimpKernel>(grid, fields, solids, waters, water, held, heldSolid, dt, 1e-12, 1e-12, 0, system);
 	}
 };
 
@@ -406,6 +406,80 @@ void expectMatrixIsThePairSum(bool periodicX, bool extraPairs = false)
 	std::printf("%ld unknowns, %ld surface nodes tied to a free neighbour\n", static_cast<long>(A.rows()), tied);
 	EXPECT_GT(fixedColumns, 0); // the drained top's p̄ reached the right-hand side
 	EXPECT_LT((system.rhs - expectedRhs).norm(), 1e-12 * expectedRhs.norm());
+}
+
+// Eq. 8.6b's local projection stabilisation S = Σ_wp V c κ/μw G_J·G_K (G_J = ∇S_J at the point less the
+// trilinear hat's gradient at the centre of its cell), read off the assembled rows as the difference
+// between c = 1 and c = 0. It must vanish on any linear nodal field at every row (what makes it consistent:
+// hydrostatic and uniform seepage untouched), be positive semi-definite, and see a node checkerboard in
+// full: that field's gradient has a zero mean over every cell, so pᵀSp = Σ_wp V κ/μw |∇p_wp|².
+TEST(PressureSystem, LocalProjectionStabilisationIsZeroOnLinearFieldsAndSeesTheCheckerboard)
+{
+	RandomPressureScene scene(false);
+	const GridGeometry& grid   = scene.grid;
+	PressureSystem&     system = scene.system;
+	const std::vector<Real> plain = system.rows;
+	stages::assemblePressureSystem<GimpKernel>(grid, scene.fields, scene.solids, scene.waters, scene.water, scene.held, scene.heldSolid, scene.dt, 1e-12, 1e-12, 1, system);
+	const std::size_t active = system.node.size();
+	// S p per grid node from the stored upper half (slot s: offset (a, b, c) with s + 62 = (a + 2) + 5 (b + 2) + 25 (c + 2))
+	auto apply = [&](const std::vector<Real>& p, Real& scale) {
+		std::vector<Real> Sp(grid.nodeCount(), 0);
+		scale = 0;
+		for (std::size_t r = 0; r < active; ++r) {
+			const std::array<int, 3> id = grid.indices(system.node[r]);
+			for (int slot = 0; slot < PressureSystem::storedOffsets; ++slot) {
+				const Real value = system.rows[r * PressureSystem::rowStride + slot] - plain[r * PressureSystem::rowStride + slot];
+				if (value == 0) continue;
+				const int o = slot + 62, x = id[0] + o % 5 - 2, y = id[1] + (o / 5) % 5 - 2, z = id[2] + o / 25 - 2;
+				const std::size_t J = grid.index(x, y, z);
+				Sp[system.node[r]] += value * p[J];
+				scale += std::abs(value * p[J]);
+				if (J != system.node[r]) Sp[J] += value * p[system.node[r]], scale += std::abs(value * p[system.node[r]]);
+			}
+		}
+		return Sp;
+	};
+	std::vector<Real> linear(grid.nodeCount()), checker(grid.nodeCount()), random(grid.nodeCount());
+	for (int k = 0; k < grid.nodes[2]; ++k)
+		for (int j = 0; j < grid.nodes[1]; ++j)
+			for (int i = 0; i < grid.nodes[0]; ++i) {
+				const std::size_t I = grid.index(i, j, k);
+				const Vec3        x = grid.nodePosition(i, j, k);
+				linear[I]           = 3e3 + 2e3 * x.x() - 5e3 * x.y() + 7e3 * x.z();
+				checker[I]          = (i + j + k) % 2 == 0 ? 1e3 : -1e3;
+				random[I]           = 1e3 * scene.unit(scene.rng);
+			}
+	Real scale = 0;
+	const std::vector<Real> onLinear = apply(linear, scale);
+	ASSERT_GT(scale, 0);
+	for (std::size_t r = 0; r < active; ++r) EXPECT_LE(std::abs(onLinear[system.node[r]]), 1e-12 * scale) << "row " << r;
+	auto energy = [&](const std::vector<Real>& p) {
+		Real s = 0, e = 0;
+		const std::vector<Real> Sp = apply(p, s);
+		for (std::size_t r = 0; r < active; ++r) e += p[system.node[r]] * Sp[system.node[r]];
+		return e;
+	};
+	EXPECT_GE(energy(random), 0);
+	// the checkerboard's Darcy energy at the points, c κ/μw interpolated as the assembly does
+	Real expected = 0;
+	const WaterPointSet& fluid = scene.fluid;
+	for (std::size_t p = 0; p < fluid.size(); ++p) {
+		Weights1D w[3];
+		detail::weightsAt<GimpKernel>(grid, fluid.position[p], fluid.halfLength[p], w);
+		Real darcy = 0;
+		Vec3 gradient = Vec3::Zero();
+		for (int c = 0; c < 3; ++c)
+			for (int b = 0; b < 3; ++b)
+				for (int a = 0; a < 3; ++a) {
+					const std::size_t I = grid.index(w[0].first + a, w[1].first + b, w[2].first + c);
+					darcy += w[0].value[a] * w[1].value[b] * w[2].value[c] * system.darcyConductance[I];
+					gradient += checker[I] * Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
+					                              w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
+				}
+		expected += fluid.volume[p] * darcy * gradient.squaredNorm();
+	}
+	ASSERT_GT(expected, 0);
+	EXPECT_NEAR(energy(checker), expected, 1e-10 * expected);
 }
 
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinition) { expectMatrixIsThePairSum(false); }

@@ -65,6 +65,8 @@ def test_read_only_outputs():
     (w.MpmTwoPhaseEngine, "pressureTolerance", 0.0, r"pressureTolerance = 0 Pa is outside the valid range \(0, inf\)"),
     (w.MpmTwoPhaseEngine, "pressureCorrections", 21, r"pressureCorrections = 21 is outside the valid range \[0, 20\]"),
     (w.MpmTwoPhaseEngine, "pressureCorrections", -1, r"pressureCorrections = -1 is outside the valid range \[0, 20\]"),
+    (w.MpmTwoPhaseEngine, "darcyStabilisation", -0.5, r"darcyStabilisation = -0.5 is outside the valid range \[0, 10\]"),
+    (w.MpmTwoPhaseEngine, "darcyStabilisation", 11.0, r"darcyStabilisation = 11 is outside the valid range \[0, 10\]"),
     (w.MpmTwoPhaseEngine, "inertiaScale", 0.5, r"inertiaScale = 0.5 is outside the valid range \[1, inf\)"),
     (w.MpmTwoPhaseEngine, "inertiaScaleRelease", 0.0, r"inertiaScaleRelease = 0 is outside the valid range \(0, inf\]"),
     # the relaxations of the explicit scheme are refused with the (default) semi-implicit one
