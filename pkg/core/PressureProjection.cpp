@@ -98,8 +98,9 @@ namespace {
 	inline bool fluctuationGradients(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const Vec3 (&dN)[S][S][S], Vec3 (&G)[S][S][S],
 	                                 int (&cellCorner)[3])
 	{
+		const std::array<int, 3> cell = cellOf(grid, position);
 		for (int d = 0; d < 3; ++d) {
-			cellCorner[d] = static_cast<int>(std::floor((position[d] - grid.origin[d]) / grid.cellSize)) - w[d].first;
+			cellCorner[d] = cell[d] - w[d].first;
 			if (cellCorner[d] < 0 || cellCorner[d] + 1 >= S) return false;
 		}
 		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
@@ -444,10 +445,12 @@ namespace stages {
 			                                          : 1 / rhoWater);
 		}
 		// eq. 8.6b: c κ/μw = c n²/Q̂ per node with the skeleton's drag (Q̂ = n²μw/κ per unit of the
-		// water-sampled support, as in eq. 8.5c); none in free water, which has no Darcy flux
-		system.darcyConductance.assign(nodes, 0);
+		// water-sampled support, as in eq. 8.5c); none in free water, which has no Darcy flux. Empty
+		// without the stabilisation (what the defect corrections read)
 		const bool stabilised = darcyStabilisation > 0;
-		if (stabilised) {
+		if (!stabilised) system.darcyConductance.clear();
+		else {
+			system.darcyConductance.assign(nodes, 0);
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 			for (std::size_t I = 0; I < nodes; ++I) {
 				const SolidNode& sn = fields.solid[I];
@@ -1517,7 +1520,7 @@ namespace stages {
 		std::vector<Real>                      balance;
 		std::vector<std::vector<Real>>         balanceBuffers;
 		Eigen::Matrix<Real, Eigen::Dynamic, 1> residual(n), step(n);
-		const bool stabilised = std::any_of(system.darcyConductance.begin(), system.darcyConductance.end(), [](Real c) { return c > 0; });
+		const bool stabilised = !system.darcyConductance.empty(); // eq. 8.6b's S is part of K
 		for (int k = 0; k < corrections; ++k) {
 			const std::vector<Real>& q = system.nodalPressure;
 			// δ(q) = Δt M⁻¹ (B q + the faces' traction), walls held, the plate moved by c (b·q): the

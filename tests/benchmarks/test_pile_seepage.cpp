@@ -326,7 +326,7 @@ TEST(ScreenedInflowFace, DISABLED_Study)
 		for (double x : { 0.05, 0.15 }) {
 			double flux = 0;
 			for (std::size_t p = 0; p < fluid.size(); ++p)
-				if (std::abs(fluid.position[p].x() - x) < h / 2) flux += fluid.volume[p] * soil.porosity * fluid.velocity[p].x();
+				if (std::abs(fluid.position[p].x() - x) < h / 2) flux += fluid.volume[p] * fluid.porosity[p] * fluid.velocity[p].x();
 			std::printf("  through-flow at x = %.2f m: %.3e m²/s\n", x, flux / (h * h));
 		}
 		for (double z : rows) {
