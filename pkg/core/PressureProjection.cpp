@@ -115,29 +115,56 @@ namespace {
 	}
 
 	// Eq. 8.6b's S at one point beyond the ∇S_J·∇S_K part that addPairTerms adds with the conductance:
-	// weight × (G_J·G_K − ∇S_J·∇S_K) for the pairs with a node of the point's cell (the others' is zero),
-	// in the stored upper half of the rows.
+	// weight × (G_J·G_K − ∇S_J·∇S_K) = weight × (H_J·H_K − ∇S_J·H_K − H_J·∇S_K), H_J = ∇N_J(x_c) on the
+	// cell's eight nodes and 0 elsewhere, so only the pairs with a node of the cell count: each stencil
+	// node against the eight (a pair of two cell nodes once), written in the stored upper half of the
+	// row of the pair's first node in the stencil's order (written so, without the cancelling
+	// G_J·G_K − ∇S_J·∇S_K, it is also exact where H is small against ∇S)
 	template <int S>
 	inline void addFluctuationPairs(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const int (&node)[3][S], const Vec3 (&dN)[S][S][S],
 	                                Real weight, const PressureSystem& system, Real* rows)
 	{
-		Vec3 G[S][S][S];
-		int  corner[3];
-		if (!fluctuationGradients<S>(grid, position, w, dN, G, corner)) return;
-		auto inCell = [&](int a, int b, int c) { return a - corner[0] >= 0 && a - corner[0] <= 1 && b - corner[1] >= 0 && b - corner[1] <= 1 && c - corner[2] >= 0 && c - corner[2] <= 1; };
+		const std::array<int, 3> cell = cellOf(grid, position);
+		int                      corner[3];
+		for (int d = 0; d < 3; ++d) {
+			corner[d] = cell[d] - w[d].first;
+			if (corner[d] < 0 || corner[d] + 1 >= S) return; // a point off the grid's cells
+		}
+		int row[S][S][S];
 		for (int c = 0; c < S; ++c)
 			for (int b = 0; b < S; ++b)
-				for (int a = 0; a < S; ++a) {
-					const int rowJ = system.row[grid.index(node[0][a], node[1][b], node[2][c])];
-					if (rowJ < 0) continue;
-					const bool cellJ = inCell(a, b, c);
-					Real*      r     = rows + static_cast<std::size_t>(rowJ) * PressureSystem::rowStride;
-					for (int cc = c; cc < S; ++cc)
-						for (int bb = cc == c ? b : 0; bb < S; ++bb)
-							for (int aa = cc == c && bb == b ? a : 0; aa < S; ++aa) {
-								if (!cellJ && !inCell(aa, bb, cc)) continue;
-								if (system.row[grid.index(node[0][aa], node[1][bb], node[2][cc])] < 0) continue;
-								r[upperSlot(aa - a, bb - b, cc - c)] += weight * (G[c][b][a].dot(G[cc][bb][aa]) - dN[c][b][a].dot(dN[cc][bb][aa]));
+				for (int a = 0; a < S; ++a) row[c][b][a] = system.row[grid.index(node[0][a], node[1][b], node[2][c])];
+		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
+		auto linear = [](int a, int b, int c) { return a + S * (b + S * c); };
+		for (int k = 0; k < 2; ++k)
+			for (int j = 0; j < 2; ++j)
+				for (int i = 0; i < 2; ++i) {
+					const int  ak = corner[0] + i, bk = corner[1] + j, ck = corner[2] + k;
+					const int  rowK = row[ck][bk][ak];
+					if (rowK < 0) continue;
+					const Vec3 HK = centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
+					const Vec3& dNK = dN[ck][bk][ak];
+					const int  lK = linear(ak, bk, ck);
+					for (int c = 0; c < S; ++c)
+						for (int b = 0; b < S; ++b)
+							for (int a = 0; a < S; ++a) {
+								const int rowJ = row[c][b][a];
+								if (rowJ < 0) continue;
+								const int  iJ = a - corner[0], jJ = b - corner[1], kJ = c - corner[2];
+								const bool cellJ = iJ >= 0 && iJ <= 1 && jJ >= 0 && jJ <= 1 && kJ >= 0 && kJ <= 1;
+								const int  lJ = linear(a, b, c);
+								if (cellJ && lJ > lK) continue; // two cell nodes: once, from the later one's turn
+								Real value;
+								if (lJ == lK) value = HK.dot(HK) - 2 * dNK.dot(HK);
+								else {
+									value = -dN[c][b][a].dot(HK);
+									if (cellJ) {
+										const Vec3 HJ = centre * Vec3(2 * iJ - 1, 2 * jJ - 1, 2 * kJ - 1);
+										value += HJ.dot(HK) - dNK.dot(HJ);
+									}
+								}
+								if (lJ <= lK) rows[static_cast<std::size_t>(rowJ) * PressureSystem::rowStride + upperSlot(ak - a, bk - b, ck - c)] += weight * value;
+								else rows[static_cast<std::size_t>(rowK) * PressureSystem::rowStride + upperSlot(a - ak, b - bk, c - ck)] += weight * value;
 							}
 				}
 	}
