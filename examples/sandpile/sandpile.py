@@ -135,6 +135,9 @@ parser.add_argument("--flip-blend", type=float, metavar="B",
 parser.add_argument("--darcy-stabilisation", type=float, metavar="C",
                     help="the engine's darcyStabilisation C, 0 ≤ C ≤ 10: the semi-implicit pressure's local projection "
                          "stabilisation (theory.md eq. 8.6b; default the engine's, 0: off)")
+parser.add_argument("--darcy-subscales", action="store_true",
+                    help="the engine's darcySubscales: that stabilisation's flux tracked at the water points as dynamic "
+                         "subscales, without a parameter (theory.md eq. 8.6c; default off)")
 parser.add_argument("--points-per-cell", type=int, default=2, metavar="N", help="points per cell and axis of each phase (default 2)")
 parser.add_argument("--shape-function", choices=("linear", "uGIMP", "cpGIMP"), default="uGIMP", help="the engine's shape functions (default uGIMP)")
 parser.add_argument("--sand-from-dem", metavar="DIR",
@@ -287,7 +290,8 @@ engine = MpmTwoPhaseEngine(
     removeFreeWater=True,       # the filtering cloth
     **({} if args.time_step_factor is None else dict(timeStepFactor=args.time_step_factor)),  # the engine refuses C outside (0, 1]
     **({} if args.flip_blend is None else dict(flipBlend=args.flip_blend)),  # and B outside [0, 1]
-    **({} if args.darcy_stabilisation is None else dict(darcyStabilisation=args.darcy_stabilisation)))  # and C outside [0, 10]
+    **({} if args.darcy_stabilisation is None else dict(darcyStabilisation=args.darcy_stabilisation)),  # and C outside [0, 10]
+    **(dict(darcySubscales=True) if args.darcy_subscales else {}))  # and with C > 0
 recorder = MpmHdf5Recorder(label="recorder", file=os.path.join(OUT, "sandpile.h5"), iterPeriod=1)
 O.engines = [engine, recorder, yade_mpm.progress(seconds=60)]  # a progress line with an ETA every minute
 
@@ -538,6 +542,7 @@ summary = {
     "time_step_factor": engine.timeStepFactor,
     "flip_blend": engine.flipBlend,
     "darcy_stabilisation": engine.darcyStabilisation,
+    "darcy_subscales": engine.darcySubscales,
     "shape_function": args.shape_function,
     "capillary_surface": args.capillary_surface,
     "solid_points": int(solid.count),

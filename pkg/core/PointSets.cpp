@@ -118,6 +118,7 @@ void WaterPointSet::resize(std::size_t n)
 	resizeCommon(n);
 	porePressure.resize(n, 0);
 	porosity.resize(n, 1);
+	subscaleFlux.resize(n, Vec3::Zero());
 }
 
 void WaterPointSet::validate(const std::string& setName, const PointFieldNames& names) const
@@ -152,6 +153,7 @@ Real WaterPointSet::removeWhere(const std::vector<char>& remove)
 	compact(halfLength, remove);
 	compact(porePressure, remove);
 	compact(porosity, remove);
+	if (subscaleFlux.size() == remove.size()) compact(subscaleFlux, remove);
 	return removed;
 }
 
@@ -167,6 +169,7 @@ std::size_t WaterPointSet::appendCopyOf(std::size_t p)
 	halfLength.push_back(l);
 	porePressure.push_back(pressure);
 	porosity.push_back(n);
+	if (subscaleFlux.size() + 1 == size()) subscaleFlux.push_back(subscaleFlux[p]);
 	return size() - 1;
 }
 

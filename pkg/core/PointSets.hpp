@@ -72,6 +72,7 @@ struct SolidPointSet : MaterialPointSet {
 struct WaterPointSet : MaterialPointSet {
 	std::vector<Real> porePressure; // p_p [Pa], compression-positive
 	std::vector<Real> porosity;     // n_p [-], 1 for free water
+	std::vector<Vec3> subscaleFlux; // q′_p [m s⁻¹]: the Darcy flux of the pressure gradient's departure from its cell mean (theory.md eq. 8.6c), 0 unless tracked
 
 	void resize(std::size_t n);
 	void validate(const std::string& setName, const PointFieldNames& names = {}) const;

@@ -169,6 +169,19 @@ namespace {
 				}
 	}
 
+	// Eq. 8.6c at one water point from its interpolated κ/μw (`darcy`) and mobility λ: the weight of S
+	// this step, the flux's instantaneous response min(κ/μw, Δt λ̄) (λ̄ the mean over the axes), and the
+	// share 1 − that/κ/μw of the last step's subscale flux that its inertia keeps against the drag
+	struct SubscaleWeights {
+		Real instant = 0, memory = 0;
+	};
+	inline SubscaleWeights subscaleWeights(Real darcy, const Vec3& lambda, Real dt)
+	{
+		if (!(darcy > 0)) return {};
+		const Real instant = std::min(darcy, dt * lambda.mean());
+		return { instant, 1 - instant / darcy };
+	}
+
 	// (S q)_J of eq. 8.6b at one water point of volume V: V c κ/μw G_J·Σ_K G_K q_K, added to the rows
 	// (q per grid node, c κ/μw interpolated from system.darcyConductance).
 	template <int S>
@@ -179,13 +192,18 @@ namespace {
 		Vec3 dN[S][S][S], G[S][S][S];
 		stencilNodes(grid, w, node);
 		Real darcy = 0;
+		Vec3 lambda = Vec3::Zero();
 		for (int c = 0; c < S; ++c)
 			for (int b = 0; b < S; ++b)
 				for (int a = 0; a < S; ++a) {
 					dN[c][b][a] = Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
 					                   w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
-					darcy += w[0].value[a] * w[1].value[b] * w[2].value[c] * system.darcyConductance[grid.index(node[0][a], node[1][b], node[2][c])];
+					const std::size_t I  = grid.index(node[0][a], node[1][b], node[2][c]);
+					const Real        Ni = w[0].value[a] * w[1].value[b] * w[2].value[c];
+					darcy += Ni * system.darcyConductance[I];
+					if (system.dynamicSubscales) lambda += Ni * system.mobility[I];
 				}
+		if (system.dynamicSubscales) darcy = subscaleWeights(darcy, lambda, system.subscaleStep).instant; // eq. 8.6c: S's weight of this step
 		int corner[3];
 		if (!(darcy > 0) || !fluctuationGradients<S>(grid, position, w, dN, G, corner)) return;
 		Vec3 g = Vec3::Zero();
@@ -475,6 +493,10 @@ namespace stages {
 		// water-sampled support, as in eq. 8.5c); none in free water, which has no Darcy flux. Empty
 		// without the stabilisation (what the defect corrections read)
 		const bool stabilised = darcyStabilisation > 0;
+		system.subscaleStep   = dt;
+		if (system.dynamicSubscales)
+			for (WaterPointSet* set : sets)
+				if (set->subscaleFlux.size() != set->size()) set->subscaleFlux.assign(set->size(), Vec3::Zero());
 		if (!stabilised) system.darcyConductance.clear();
 		else {
 			system.darcyConductance.assign(nodes, 0);
@@ -561,6 +583,11 @@ namespace stages {
 				const Real storage    = waterPointStorage(V, n, invKw, dt); // consistent: Σ V S_J S_K n/(Kw Δt)
 				// Δt L (eq. 8.6), per axis, and the ∇S_J·∇S_K part of eq. 8.6b's S, whose remainder follows
 				Vec3 conductance = dt * V * lambda;
+				Real memory = 0; // eq. 8.6c: the share of the last step's subscale flux carried over
+				if (system.dynamicSubscales) {
+					const SubscaleWeights sw = subscaleWeights(darcy, lambda, dt);
+					darcy = sw.instant, memory = sw.memory;
+				}
 				if (darcy > 0) conductance += Vec3::Constant(V * darcy);
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n
 				for (int c = 0; c < S; ++c)
@@ -572,6 +599,19 @@ namespace stages {
 						}
 				addPairTerms<S>(grid, w, node, storage, conductance, system, rows);
 				if (darcy > 0) addFluctuationPairs<S>(grid, P.position[p], w, node, dN, V * darcy, system, rows);
+				if (memory > 0 && !P.subscaleFlux[p].isZero()) { // + V G_J·(memory q′^n): the subscale flux's divergence it keeps
+					Vec3 G[S][S][S];
+					int  corner[3];
+					if (fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner)) {
+						const Vec3 kept = V * memory * P.subscaleFlux[p];
+						for (int c = 0; c < S; ++c)
+							for (int b = 0; b < S; ++b)
+								for (int a = 0; a < S; ++a) {
+									const int r = system.row[grid.index(node[0][a], node[1][b], node[2][c])];
+									if (r >= 0) rows[static_cast<std::size_t>(r) * PressureSystem::rowStride + PressureSystem::rhsSlot] += G[c][b][a].dot(kept);
+								}
+					}
+				}
 			});
 		}
 		// the solid's share of the volume balance, (1 − n)∇·vs − vs·∇n, at the solid points (eq. 8.2):
@@ -905,6 +945,45 @@ namespace stages {
 	                              const std::vector<Real>& pressure, bool storePointPressures, PressureSystem& system)
 	{
 		system.forces.assign(grid.nodeCount(), zeroOf(PressureForceNode {}));
+		// eq. 8.6c: q′^{n+1} = memory q′^n − instant Σ_J G_J p_J^{n+1}, with the weights of the assembly
+		if (storePointPressures && system.dynamicSubscales && !system.darcyConductance.empty()) {
+			constexpr int S = Kernel::stencil;
+			for (WaterPointSet* set : sets) {
+				WaterPointSet& P = *set;
+				if (P.subscaleFlux.size() != P.size()) P.subscaleFlux.assign(P.size(), Vec3::Zero());
+#pragma omp parallel for schedule(static) if(P.size() > parallelThreshold)
+				for (std::size_t p = 0; p < P.size(); ++p) {
+					Weights1D w[3];
+					weightsAt<Kernel>(grid, P, p, w);
+					int node[3][S];
+					stencilNodes(grid, w, node);
+					Real darcy = 0;
+					Vec3 lambda = Vec3::Zero();
+					Vec3 dN[S][S][S], G[S][S][S];
+					for (int c = 0; c < S; ++c)
+						for (int b = 0; b < S; ++b)
+							for (int a = 0; a < S; ++a) {
+								const std::size_t I  = grid.index(node[0][a], node[1][b], node[2][c]);
+								const Real        Ni = w[0].value[a] * w[1].value[b] * w[2].value[c];
+								dN[c][b][a] = Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
+								                   w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
+								darcy += Ni * system.darcyConductance[I];
+								lambda += Ni * system.mobility[I];
+							}
+					const SubscaleWeights sw = subscaleWeights(darcy, lambda, system.subscaleStep);
+					int corner[3];
+					if (!(sw.instant > 0) || !fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner)) {
+						P.subscaleFlux[p].setZero();
+						continue;
+					}
+					Vec3 g = Vec3::Zero();
+					for (int c = 0; c < S; ++c)
+						for (int b = 0; b < S; ++b)
+							for (int a = 0; a < S; ++a) g += pressure[grid.index(node[0][a], node[1][b], node[2][c])] * G[c][b][a];
+					P.subscaleFlux[p] = sw.memory * P.subscaleFlux[p] - sw.instant * g;
+				}
+			}
+		}
 		for (std::size_t s = 0; s < sets.size(); ++s) {
 			WaterPointSet&           P     = *sets[s];
 			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {

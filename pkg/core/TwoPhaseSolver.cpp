@@ -122,6 +122,10 @@ void SolverSettings::validate() const
 	requireOpenRange("pressureTolerance", pressureTolerance, 0, inf, "Pa");
 	if (!(pressureCorrections >= 0 && pressureCorrections <= maxPressureCorrections)) throwOutOfRange("pressureCorrections", pressureCorrections, "", "[0, " + std::to_string(maxPressureCorrections) + "]");
 	if (!(darcyStabilisation >= 0 && darcyStabilisation <= maxDarcyStabilisation)) throwOutOfRange("darcyStabilisation", darcyStabilisation, "", "[0, " + std::to_string(static_cast<int>(maxDarcyStabilisation)) + "]");
+	if (darcySubscales && darcyStabilisation > 0)
+		throw InvalidParameter("darcySubscales = True sets the stabilisation's weight itself (theory.md eq. 8.6c): it needs darcyStabilisation = 0, not " + std::to_string(darcyStabilisation));
+	if (scheme == TimeScheme::Explicit && darcySubscales)
+		throw InvalidParameter("darcySubscales = True belongs to the semi-implicit scheme (theory.md eq. 8.6c): it needs scheme = 'semi-implicit'");
 	if (!(maxSubSteps >= 1)) throwOutOfRange("maxSubSteps", maxSubSteps, "", "[1, inf)");
 	if (!(inertiaScale >= 1 && std::isfinite(inertiaScale))) throwOutOfRange("inertiaScale", inertiaScale, "", "[1, inf)");
 	if (!(inertiaScaleRelease > 0)) throwOutOfRange("inertiaScaleRelease", inertiaScaleRelease, "", "(0, inf]");
@@ -423,8 +427,9 @@ std::vector<ProjectionForms> TwoPhaseSolver::projectionFormsWith(Real dt, const 
 {
 	using namespace stages;
 	predictForCheck<Kernel>(dt);
+	pressureSystem_.dynamicSubscales = settings_.darcySubscales;
 	assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
-	                               settings_.darcyStabilisation, pressureSystem_);
+	                               settings_.darcySubscales ? 1 : settings_.darcyStabilisation, pressureSystem_);
 	if (settings_.capillarySurface) { // the step's K as its first round builds it: the held nodes free, eq. 8.5f's terms in
 		std::vector<char> candidate, held;
 		const long        undetermined = undeterminedSurfaceNodes_; // a check leaves the run's count as it was
@@ -691,13 +696,14 @@ template <class Kernel> void TwoPhaseSolver::projectWithCapillarySurface(Real dt
 
 template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
 {
+	pressureSystem_.dynamicSubscales = settings_.darcySubscales; // eq. 8.6c
 	using namespace stages;
 	const Vec3& g = settings_.gravity;
 	{
 		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.1–8.7
 		classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, pressureSystem_);
 		assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
-		                               settings_.darcyStabilisation, pressureSystem_);
+		                               settings_.darcySubscales ? 1 : settings_.darcyStabilisation, pressureSystem_);
 		if (!constrained_.plate.empty()) assemblePlateCoupling<Kernel>(grid_, fields_, solids_, waters_, constrained_, plate_, dt, pressureSystem_);
 		else pressureSystem_.plateCoupling.clear();
 		if (!settings_.capillarySurface) buildPressureMatrix(grid_, pressureSystem_);

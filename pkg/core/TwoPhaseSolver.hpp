@@ -29,6 +29,7 @@ struct SolverSettings {
 	Real          darcyStabilisation         = 0;     // c [-], 0 ≤ c ≤ 10: the semi-implicit projection's local projection stabilisation, c κ/μw on the pressure gradient's departure from its cell mean (eq. 8.6b); 0: none
 	Real          freeSurfaceThreshold       = 0;    // β [-], 0 ≤ β < 1: p = 0 on points filled below β (eq. 2.3); 0: off
 	bool          freeSurfaceHoldsSuction    = false; // eq. 2.3b (explicit scheme only): the surface keeps suction (p < 0) and releases only p > 0
+	bool          darcySubscales             = false; // eq. 8.6c (semi-implicit scheme only): eq. 8.6b's flux tracked at the water points as dynamic subscales: S weighted by its response within the step, min(κ/μw, Δt λ), and each point's subscale flux carried to the next step by the water's inertia against its drag; no parameter (with darcyStabilisation = 0)
 	bool          capillarySurface           = false; // eq. 8.5e (semi-implicit scheme only): a soil surface node with the skeleton holds suction (p < 0, no relative flow) and is a seepage face (p = 0) only where it would hold p > 0
 	long          maxSubSteps                = 100000; // N_max [-] ≥ 1: advance(dt) refuses a dt that needs more sub-steps than this (a mistyped step, not a run)
 	Real          inertiaScale               = 1;    // α [-] ≥ 1: both phases' inertia × α, weights, drag and stresses not (eq. 4.8b); the step grows as √α

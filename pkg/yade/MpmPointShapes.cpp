@@ -62,6 +62,8 @@ const AttrTable<MpmWaterPoints>& MpmWaterPoints::attributes()
 		for (auto&& spec : AttrTable<W> {
 		             pointArrayAttr("porePressure", &W::points, &WaterPointSet::porePressure, "Pore-water pressure p (compression-positive), shape (N,) [Pa]"),
 		             pointArrayAttr("porosity", &W::points, &WaterPointSet::porosity, "Porosity n interpolated at each water point (1 for free water), shape (N,) [-]"),
+		             pointArrayAttr("subscaleFlux", &W::points, &WaterPointSet::subscaleFlux,
+		                            "Darcy flux of each water point's pressure-gradient departure from its cell mean, carried from step to step with MpmTwoPhaseEngine.darcySubscales (theory.md eq. 8.6c; zeros otherwise), shape (N, 3) [m s⁻¹]"),
 		     })
 			t.push_back(std::move(spec));
 		return t;

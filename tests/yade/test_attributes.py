@@ -88,6 +88,16 @@ def test_capillary_surface_belongs_to_the_semi_implicit_scheme():
         w.MpmTwoPhaseEngine(scheme="explicit", capillarySurface=True)
 
 
+def test_darcy_subscales_belong_to_the_semi_implicit_scheme_and_set_their_own_weight():
+    # theory.md eq. 8.6c tracks the stabilisation's flux at the water points of the pressure
+    # projection: refused with the explicit scheme, and with a static weight c at the same time
+    w.MpmTwoPhaseEngine(darcySubscales=True)
+    with pytest.raises(ValueError, match=r"darcySubscales = True .* needs scheme = 'semi-implicit'"):
+        w.MpmTwoPhaseEngine(scheme="explicit", darcySubscales=True)
+    with pytest.raises(ValueError, match=r"darcySubscales = True .* needs darcyStabilisation = 0, not 1"):
+        w.MpmTwoPhaseEngine(darcySubscales=True, darcyStabilisation=1.0)
+
+
 def test_point_arrays_are_numpy_with_documented_shapes():
     rng = np.random.default_rng(7)
     pos = rng.random((11, 3))

@@ -39,7 +39,7 @@ def build_scene():
     O.bodies.append([solid_body, water_body])
     O.engines = [w.MpmTwoPhaseEngine(label="mpm", gravity=(0.1, -0.2, -9.80665), timeStepFactor=1 / 3, flipBlend=0.987,
                                      solidWalls=("slip",) * 2 + ("free",) * 2 + ("frictional", "free"), wallFriction=(0, 0, 0, 0, 0.6543, 0),
-                                     periodic=(False, True, False))]
+                                     periodic=(False, True, False), darcySubscales=True)]
     O.dt = 1.2345e-5
     O.run(3, True)
 
