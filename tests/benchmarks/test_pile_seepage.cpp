@@ -26,9 +26,9 @@
 // held at p = 0 with no capillary suction, draws water in at the crest (where the head inside falls
 // below H) as well as letting it out on the slope: the flux through a section is not the inflow
 // until the phreatic surface has dropped, which takes tens of seconds (doc/theory.md §8, Open).
-#include "core/Stencil.hpp"
 #include "core/TwoPhaseSolver.hpp"
 #include "support/Fixtures.hpp"
+#include "support/Stabilisation.hpp"
 
 #include <gtest/gtest.h>
 
@@ -256,27 +256,10 @@ void expectPileSeepageIsTheLaplaceSolution(bool subscales)
 		ASSERT_FALSE(system.darcyConductance.empty());
 		double residual = 0, scale = 0;
 		for (std::size_t p = 0; p < fluid.size(); ++p) {
-			Weights1D w[3];
-			detail::weightsAt<GimpKernel>(grid, fluid.position[p], fluid.halfLength[p], w);
-			double darcy = 0;
-			Vec3   gradient = Vec3::Zero();
-			for (int c = 0; c < 3; ++c)
-				for (int b = 0; b < 3; ++b)
-					for (int a = 0; a < 3; ++a) {
-						const std::size_t I = grid.index(w[0].first + a, w[1].first + b, w[2].first + c);
-						darcy += w[0].value[a] * w[1].value[b] * w[2].value[c] * system.darcyConductance[I];
-						gradient += system.nodalPressure[I] * Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
-						                                           w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
-					}
-			if (!(darcy > 0)) continue;
-			const Vec3 u  = (fluid.position[p] - grid.origin) / grid.cellSize;
-			const int  i0 = static_cast<int>(std::floor(u[0])), j0 = static_cast<int>(std::floor(u[1])), k0 = static_cast<int>(std::floor(u[2]));
-			for (int c = 0; c < 2; ++c)
-				for (int b = 0; b < 2; ++b)
-					for (int a = 0; a < 2; ++a)
-						gradient -= system.nodalPressure[grid.index(i0 + a, j0 + b, k0 + c)] * Vec3(2 * a - 1, 2 * b - 1, 2 * c - 1) / (4 * grid.cellSize);
-			residual += (fluid.subscaleFlux[p] + darcy * gradient).squaredNorm();
-			scale += (darcy * gradient).squaredNorm();
+			const fixtures::GradientDeparture g = fixtures::gradientDeparture(grid, fluid.position[p], fluid.halfLength[p], system.darcyConductance, system.nodalPressure);
+			if (!(g.darcy > 0)) continue;
+			residual += (fluid.subscaleFlux[p] + g.darcy * g.departure).squaredNorm();
+			scale += (g.darcy * g.departure).squaredNorm();
 		}
 		// (without the share carried over, q′ = −s g′ would miss by 1 − s/(κ/μw) ≈ 1 − Δt/τ here)
 		std::printf("  subscale flux against −κ/μw g′ at the last solve: relative L2 residual %.2e; Δt/τ %.2g\n", std::sqrt(residual / scale),

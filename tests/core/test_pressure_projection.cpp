@@ -6,6 +6,7 @@
 #include "core/Stencil.hpp"
 #include "core/TwoPhaseSolver.hpp"
 #include "support/Fixtures.hpp"
+#include "support/Stabilisation.hpp"
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -467,25 +468,8 @@ TEST(PressureSystem, LocalProjectionStabilisationIsZeroOnLinearFieldsAndSeesTheC
 	auto definition = [&](const std::vector<Real>& field) {
 		Real sum = 0;
 		for (std::size_t p = 0; p < fluid.size(); ++p) {
-			Weights1D w[3];
-			detail::weightsAt<GimpKernel>(grid, fluid.position[p], fluid.halfLength[p], w);
-			Real darcy = 0;
-			Vec3 gradient = Vec3::Zero();
-			for (int c = 0; c < 3; ++c)
-				for (int b = 0; b < 3; ++b)
-					for (int a = 0; a < 3; ++a) {
-						const std::size_t I = grid.index(w[0].first + a, w[1].first + b, w[2].first + c);
-						darcy += w[0].value[a] * w[1].value[b] * w[2].value[c] * system.darcyConductance[I];
-						gradient += field[I] * Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
-						                            w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
-					}
-			const Vec3 u = (fluid.position[p] - grid.origin) / grid.cellSize;
-			const int  i0 = static_cast<int>(std::floor(u[0])), j0 = static_cast<int>(std::floor(u[1])), k0 = static_cast<int>(std::floor(u[2]));
-			for (int k = 0; k < 2; ++k)
-				for (int j = 0; j < 2; ++j)
-					for (int i = 0; i < 2; ++i) // ∂N/∂x of a trilinear hat at its cell's centre: ±1/(4h) per axis
-						gradient -= field[grid.index(i0 + i, j0 + j, k0 + k)] * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1) / (4 * grid.cellSize);
-			sum += fluid.volume[p] * darcy * gradient.squaredNorm();
+			const fixtures::GradientDeparture d = fixtures::gradientDeparture(grid, fluid.position[p], fluid.halfLength[p], system.darcyConductance, field);
+			sum += fluid.volume[p] * d.darcy * d.departure.squaredNorm();
 		}
 		return sum;
 	};
