@@ -129,6 +129,9 @@ void WaterPointSet::validate(const std::string& setName, const PointFieldNames& 
 	requireSize(setName, "porosity", porosity, n);
 	requireFinite(setName, "porePressure", porePressure, "Pa");
 	requirePorosity(setName, porosity, true);
+	// empty: not tracked (theory.md eq. 8.6c starts it at zero); else one finite entry per point
+	if (!subscaleFlux.empty()) requireSize(setName, "subscaleFlux", subscaleFlux, n);
+	requireFinite(setName, "subscaleFlux", subscaleFlux, "m s⁻¹");
 }
 
 namespace {

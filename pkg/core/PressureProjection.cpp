@@ -94,15 +94,23 @@ namespace {
 	// point's cell (zero off the cell's eight nodes), so that Σ_J G_J p_J is the part of the point's
 	// pressure gradient that departs from the cell's mean one: zero for any linear nodal field. Returns
 	// false where the cell's nodes are not all in the stencil (a point off the grid's cells).
-	template <int S>
-	inline bool fluctuationGradients(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const Vec3 (&dN)[S][S][S], Vec3 (&G)[S][S][S],
-	                                 int (&cellCorner)[3])
+	// The stencil index of the lower corner of the point's cell per axis; false where the cell's nodes
+	// are not all in the stencil (a point off the grid's cells).
+	template <int S> inline bool cellCornerInStencil(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], int (&cellCorner)[3])
 	{
 		const std::array<int, 3> cell = cellOf(grid, position);
 		for (int d = 0; d < 3; ++d) {
 			cellCorner[d] = cell[d] - w[d].first;
 			if (cellCorner[d] < 0 || cellCorner[d] + 1 >= S) return false;
 		}
+		return true;
+	}
+
+	template <int S>
+	inline bool fluctuationGradients(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const Vec3 (&dN)[S][S][S], Vec3 (&G)[S][S][S],
+	                                 int (&cellCorner)[3])
+	{
+		if (!cellCornerInStencil<S>(grid, position, w, cellCorner)) return false;
 		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
 		for (int c = 0; c < S; ++c)
 			for (int b = 0; b < S; ++b)
@@ -124,12 +132,8 @@ namespace {
 	inline void addFluctuationPairs(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const int (&node)[3][S], const Vec3 (&dN)[S][S][S],
 	                                Real weight, const PressureSystem& system, Real* rows)
 	{
-		const std::array<int, 3> cell = cellOf(grid, position);
-		int                      corner[3];
-		for (int d = 0; d < 3; ++d) {
-			corner[d] = cell[d] - w[d].first;
-			if (corner[d] < 0 || corner[d] + 1 >= S) return; // a point off the grid's cells
-		}
+		int corner[3];
+		if (!cellCornerInStencil<S>(grid, position, w, corner)) return;
 		int row[S][S][S];
 		for (int c = 0; c < S; ++c)
 			for (int b = 0; b < S; ++b)
@@ -169,6 +173,26 @@ namespace {
 				}
 	}
 
+	// At one point of stencil `node`: the weight gradients ∇S_J, and the nodes' c κ/μw (`darcy`) and
+	// mobility λ interpolated (λ only where eq. 8.6c needs it)
+	template <int S>
+	inline void darcyAtPoint(const GridGeometry& grid, const Weights1D (&w)[3], const int (&node)[3][S], const PressureSystem& system, bool withMobility,
+	                         Vec3 (&dN)[S][S][S], Real& darcy, Vec3& lambda)
+	{
+		darcy  = 0;
+		lambda = Vec3::Zero();
+		for (int c = 0; c < S; ++c)
+			for (int b = 0; b < S; ++b)
+				for (int a = 0; a < S; ++a) {
+					dN[c][b][a] = Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
+					                   w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
+					const std::size_t I  = grid.index(node[0][a], node[1][b], node[2][c]);
+					const Real        Ni = w[0].value[a] * w[1].value[b] * w[2].value[c];
+					darcy += Ni * system.darcyConductance[I];
+					if (withMobility) lambda += Ni * system.mobility[I];
+				}
+	}
+
 	// Eq. 8.6c at one water point from its interpolated κ/μw (`darcy`) and mobility λ: the weight of S
 	// this step, the flux's instantaneous response min(κ/μw, Δt λ̄) (λ̄ the mean over the axes), and the
 	// share 1 − that/κ/μw of the last step's subscale flux that its inertia keeps against the drag
@@ -191,18 +215,9 @@ namespace {
 		int  node[3][S];
 		Vec3 dN[S][S][S], G[S][S][S];
 		stencilNodes(grid, w, node);
-		Real darcy = 0;
-		Vec3 lambda = Vec3::Zero();
-		for (int c = 0; c < S; ++c)
-			for (int b = 0; b < S; ++b)
-				for (int a = 0; a < S; ++a) {
-					dN[c][b][a] = Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
-					                   w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
-					const std::size_t I  = grid.index(node[0][a], node[1][b], node[2][c]);
-					const Real        Ni = w[0].value[a] * w[1].value[b] * w[2].value[c];
-					darcy += Ni * system.darcyConductance[I];
-					if (system.dynamicSubscales) lambda += Ni * system.mobility[I];
-				}
+		Real darcy;
+		Vec3 lambda;
+		darcyAtPoint<S>(grid, w, node, system, system.dynamicSubscales, dN, darcy, lambda);
 		if (system.dynamicSubscales) darcy = subscaleWeights(darcy, lambda, system.subscaleStep).instant; // eq. 8.6c: S's weight of this step
 		int corner[3];
 		if (!(darcy > 0) || !fluctuationGradients<S>(grid, position, w, dN, G, corner)) return;
@@ -599,7 +614,7 @@ namespace stages {
 						}
 				addPairTerms<S>(grid, w, node, storage, conductance, system, rows);
 				if (darcy > 0) addFluctuationPairs<S>(grid, P.position[p], w, node, dN, V * darcy, system, rows);
-				if (memory > 0 && !P.subscaleFlux[p].isZero()) { // + V G_J·(memory q′^n): the subscale flux's divergence it keeps
+				if (memory > 0 && P.subscaleFlux[p] != Vec3::Zero()) { // exactly: a clay's flux of 1e-13 m/s counts too // + V G_J·(memory q′^n): the subscale flux's divergence it keeps
 					Vec3 G[S][S][S];
 					int  corner[3];
 					if (fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner)) {
@@ -957,19 +972,9 @@ namespace stages {
 					weightsAt<Kernel>(grid, P, p, w);
 					int node[3][S];
 					stencilNodes(grid, w, node);
-					Real darcy = 0;
-					Vec3 lambda = Vec3::Zero();
-					Vec3 dN[S][S][S], G[S][S][S];
-					for (int c = 0; c < S; ++c)
-						for (int b = 0; b < S; ++b)
-							for (int a = 0; a < S; ++a) {
-								const std::size_t I  = grid.index(node[0][a], node[1][b], node[2][c]);
-								const Real        Ni = w[0].value[a] * w[1].value[b] * w[2].value[c];
-								dN[c][b][a] = Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
-								                   w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
-								darcy += Ni * system.darcyConductance[I];
-								lambda += Ni * system.mobility[I];
-							}
+					Real darcy;
+					Vec3 lambda, dN[S][S][S], G[S][S][S];
+					darcyAtPoint<S>(grid, w, node, system, true, dN, darcy, lambda);
 					const SubscaleWeights sw = subscaleWeights(darcy, lambda, system.subscaleStep);
 					int corner[3];
 					if (!(sw.instant > 0) || !fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner)) {

@@ -429,7 +429,7 @@ std::vector<ProjectionForms> TwoPhaseSolver::projectionFormsWith(Real dt, const 
 	predictForCheck<Kernel>(dt);
 	pressureSystem_.dynamicSubscales = settings_.darcySubscales;
 	assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
-	                               settings_.darcySubscales ? 1 : settings_.darcyStabilisation, pressureSystem_);
+	                               settings_.darcyConductanceFactor(), pressureSystem_);
 	if (settings_.capillarySurface) { // the step's K as its first round builds it: the held nodes free, eq. 8.5f's terms in
 		std::vector<char> candidate, held;
 		const long        undetermined = undeterminedSurfaceNodes_; // a check leaves the run's count as it was
@@ -703,7 +703,7 @@ template <class Kernel> void TwoPhaseSolver::projectPressure(Real dt)
 		StageTimer t(stageSeconds_, Stage::AssemblePressure); // eqs. 8.1–8.7
 		classifyPressureNodes<Kernel>(grid_, fields_, waters_, domain_.boundaries, g, water_.density, pressureSystem_);
 		assemblePressureSystem<Kernel>(grid_, fields_, solids_, waters_, inertialWater(water_, inertiaScale_), constrained_, heldSolid_, dt, solidMassTolerance_, waterMassTolerance_,
-		                               settings_.darcySubscales ? 1 : settings_.darcyStabilisation, pressureSystem_);
+		                               settings_.darcyConductanceFactor(), pressureSystem_);
 		if (!constrained_.plate.empty()) assemblePlateCoupling<Kernel>(grid_, fields_, solids_, waters_, constrained_, plate_, dt, pressureSystem_);
 		else pressureSystem_.plateCoupling.clear();
 		if (!settings_.capillarySurface) buildPressureMatrix(grid_, pressureSystem_);

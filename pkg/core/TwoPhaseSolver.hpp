@@ -36,6 +36,8 @@ struct SolverSettings {
 	bool          reuseStencilWeights        = true;  // GIMP kernels: each point's weights computed once per position set and read by every stage of the step (theory.md §4, stencil weights); results identical bit for bit, false only to measure the gain
 	Real          inertiaScaleRelease        = 0.1;  // ε [-] > 0: α returns to 1 for good once the skeleton's net inertial force exceeds ε × its weight (eq. 4.8c); inf: never
 	void          validate() const;
+	// c of eq. 8.6b's node conductance c κ/μw: the dynamic subscales (eq. 8.6c) weight κ/μw themselves
+	Real          darcyConductanceFactor() const { return darcySubscales ? 1 : darcyStabilisation; }
 };
 
 // A box in which water points are removed (an outflow sink, e.g. the filtering cloth of a flume).

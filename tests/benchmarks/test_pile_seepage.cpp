@@ -256,10 +256,10 @@ void expectPileSeepageIsTheLaplaceSolution(bool subscales)
 		ASSERT_FALSE(system.darcyConductance.empty());
 		double residual = 0, scale = 0;
 		for (std::size_t p = 0; p < fluid.size(); ++p) {
-			const fixtures::GradientDeparture g = fixtures::gradientDeparture(grid, fluid.position[p], fluid.halfLength[p], system.darcyConductance, system.nodalPressure);
-			if (!(g.darcy > 0)) continue;
-			residual += (fluid.subscaleFlux[p] + g.darcy * g.departure).squaredNorm();
-			scale += (g.darcy * g.departure).squaredNorm();
+			const fixtures::GradientDeparture at = fixtures::gradientDeparture(grid, fluid.position[p], fluid.halfLength[p], system.darcyConductance, system.nodalPressure);
+			if (!(at.darcy > 0)) continue;
+			residual += (fluid.subscaleFlux[p] + at.darcy * at.departure).squaredNorm();
+			scale += (at.darcy * at.departure).squaredNorm();
 		}
 		// (without the share carried over, q′ = −s g′ would miss by 1 − s/(κ/μw) ≈ 1 − Δt/τ here)
 		std::printf("  subscale flux against −κ/μw g′ at the last solve: relative L2 residual %.2e; Δt/τ %.2g\n", std::sqrt(residual / scale),

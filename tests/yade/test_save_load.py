@@ -61,6 +61,8 @@ def test_save_tmp_round_trip_in_process(tmp_path):
     exec(SCENE, namespace)
     namespace["build_scene"]()
     before = namespace["snapshot"]()
+    # darcySubscales is on: the water points carry a subscale flux, which the round trip must keep
+    assert np.abs(np.asarray(O.bodies[1].shape.subscaleFlux)).max() > 0
     O.saveTmp("mpm")
     O.reset()
     O.loadTmp("mpm")
@@ -137,6 +139,12 @@ def test_a_truncated_or_corrupt_saved_scene_is_reported_at_the_load_naming_the_f
     spoilt = tmp_path / "spoilt.xml"
     spoilt.write_text(text[:item] + "<item>nan</item>" + text[text.index("</item>", item) + len("</item>"):])
     with pytest.raises(ValueError, match=r"O.load\('.*spoilt.xml'\): O.bodies\[1\].shape.porePressure\[0\] = nan is not finite: the saved scene is corrupt"):
+        O.load(str(spoilt))
+    # the carried subscale flux (theory.md eq. 8.6c) is checked as the other point arrays
+    start = text.index("<subscaleFlux>")
+    item = text.index("<item>", start)
+    spoilt.write_text(text[:item] + "<item>inf</item>" + text[text.index("</item>", item) + len("</item>"):])
+    with pytest.raises(ValueError, match=r"O.load\('.*spoilt.xml'\): O.bodies\[1\].shape.subscaleFlux\[0\] = .*inf.* is not finite: the saved scene is corrupt"):
         O.load(str(spoilt))
     O.load(str(saved))  # the intact file still loads and runs
     O.step()
