@@ -3,7 +3,7 @@
 // seconds per wall second, CG iterations per step, and the share of each stage. A soil point is one
 // solid point with its water point.
 //
-// Usage: mpm_bench CELLS_PER_SIDE|column STEPS REPEATS [dry] [explicit] [corrected] [linear] [uncached]
+// Usage: mpm_bench CELLS_PER_SIDE|column STEPS REPEATS [dry] [explicit] [corrected] [linear] [uncached] [plain]
 // CELLS_PER_SIDE: a saturated 3D block under gravity and a sudden 10 kPa on its top, two point sets
 // (solid + water, 2×2×2 each per cell), cell averaging, at 0.5 × the scheme's critical step.
 // `column`: the reference two-phase MPM's 3D consolidation column (cb-geo/mpm-benchmarks
@@ -14,7 +14,8 @@
 // block then takes Kw = 2.2e8 Pa, as the explicit sand pile); `corrected`: two defect corrections of
 // the pressure per step (pressureCorrections = 2, theory.md eq. 8.7b); `dry`: solid points only (the
 // soil-point column then counts solid points); `linear`: linear shape functions instead of uGIMP;
-// `uncached`: every stage computes the stencil weights again (SolverSettings::reuseStencilWeights off).
+// `uncached`: every stage computes the stencil weights again (SolverSettings::reuseStencilWeights off);
+// `plain`: the semi-implicit pressure without its dynamic subscales (darcySubscales off, theory.md eq. 8.6c).
 #include "core/TwoPhaseSolver.hpp"
 #include "support/Fixtures.hpp"
 
@@ -57,7 +58,7 @@ double cpuSeconds()
 
 int main(int argc, char** argv)
 {
-	bool dry = false, explicitScheme = false, corrected = false, linear = false, uncached = false, valid = argc >= 4;
+	bool dry = false, explicitScheme = false, corrected = false, linear = false, uncached = false, plain = false, valid = argc >= 4;
 	for (int a = 4; a < argc; ++a) {
 		const std::string option = argv[a];
 		if (option == "dry") dry = true;
@@ -65,11 +66,12 @@ int main(int argc, char** argv)
 		else if (option == "corrected") corrected = true;
 		else if (option == "linear") linear = true;
 		else if (option == "uncached") uncached = true;
+		else if (option == "plain") plain = true;
 		else valid = false;
 	}
 	const bool column = valid && std::string(argv[1]) == "column";
 	if (!valid || (!column && std::atoi(argv[1]) < 1)) {
-		std::fprintf(stderr, "usage: %s CELLS_PER_SIDE|column STEPS REPEATS [dry] [explicit] [corrected] [linear] [uncached]\n", argv[0]);
+		std::fprintf(stderr, "usage: %s CELLS_PER_SIDE|column STEPS REPEATS [dry] [explicit] [corrected] [linear] [uncached] [plain]\n", argv[0]);
 		return 2;
 	}
 	const int    steps = std::atoi(argv[2]), repeats = std::atoi(argv[3]);
@@ -105,6 +107,7 @@ int main(int argc, char** argv)
 	s.gravity = column ? Vec3::Zero() : Vec3(0, 0, -g);
 	if (linear) s.shapeFunction = ShapeFunction::Linear;
 	s.reuseStencilWeights = !uncached;
+	s.darcySubscales      = !plain;
 	if (corrected) s.pressureCorrections = 2;
 	if (explicitScheme) {
 		s.scheme              = TimeScheme::Explicit;

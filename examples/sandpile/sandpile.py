@@ -132,12 +132,13 @@ parser.add_argument("--time-step-factor", type=float, metavar="C",
 parser.add_argument("--flip-blend", type=float, metavar="B",
                     help="the engine's flipBlend B, 0 ≤ B ≤ 1: the FLIP share of the points' velocity update, the rest PIC "
                          "(default the engine's, 1: pure FLIP). It changes the pile's answer, not its cost (doc/sandpile.md Cost knobs)")
+parser.add_argument("--darcy-subscales", action=argparse.BooleanOptionalAction, default=True,
+                    help="the engine's darcySubscales: the semi-implicit pressure's stabilisation, the Darcy flux of each water "
+                         "point's gradient departure from its cell mean tracked at the points as dynamic subscales, without a "
+                         "parameter (theory.md eq. 8.6c; default on, the engine's default)")
 parser.add_argument("--darcy-stabilisation", type=float, metavar="C",
-                    help="the engine's darcyStabilisation C, 0 ≤ C ≤ 10: the semi-implicit pressure's local projection "
-                         "stabilisation (theory.md eq. 8.6b; default the engine's, 0: off)")
-parser.add_argument("--darcy-subscales", action="store_true",
-                    help="the engine's darcySubscales: that stabilisation's flux tracked at the water points as dynamic "
-                         "subscales, without a parameter (theory.md eq. 8.6c; default off)")
+                    help="the engine's darcyStabilisation C, 0 ≤ C ≤ 10: that stabilisation's quasi-static form with weight C "
+                         "(theory.md eq. 8.6b; needs --no-darcy-subscales; default the engine's, 0)")
 parser.add_argument("--points-per-cell", type=int, default=2, metavar="N", help="points per cell and axis of each phase (default 2)")
 parser.add_argument("--shape-function", choices=("linear", "uGIMP", "cpGIMP"), default="uGIMP", help="the engine's shape functions (default uGIMP)")
 parser.add_argument("--sand-from-dem", metavar="DIR",
@@ -291,7 +292,7 @@ engine = MpmTwoPhaseEngine(
     **({} if args.time_step_factor is None else dict(timeStepFactor=args.time_step_factor)),  # the engine refuses C outside (0, 1]
     **({} if args.flip_blend is None else dict(flipBlend=args.flip_blend)),  # and B outside [0, 1]
     **({} if args.darcy_stabilisation is None else dict(darcyStabilisation=args.darcy_stabilisation)),  # and C outside [0, 10]
-    **(dict(darcySubscales=True) if args.darcy_subscales else {}))  # and with C > 0
+    darcySubscales=args.darcy_subscales)  # and refuses C > 0 with the subscales on
 recorder = MpmHdf5Recorder(label="recorder", file=os.path.join(OUT, "sandpile.h5"), iterPeriod=1)
 O.engines = [engine, recorder, yade_mpm.progress(seconds=60)]  # a progress line with an ETA every minute
 

@@ -31,7 +31,7 @@ struct RestResult {
 };
 
 RestResult columnAtRest(double hydraulicConductivity, double waterBulkModulus, double h, int steps, double darcyStabilisation = 0, long corrections = 0,
-                        bool subscales = false)
+                        bool subscales = SolverSettings {}.darcySubscales)
 {
 	const double    g = g0, H = 20 * h;
 	SoilParameters  soil;

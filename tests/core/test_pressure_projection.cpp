@@ -135,7 +135,8 @@ TEST(PressureSystem, StorageIsKeptWhileTheNodeCountMoves)
 	for (std::size_t p = 0; p < solid.size(); ++p) // 100 kPa on the top layer of solid points
 		if (solid.position[p].z() > size.z() - lattice.spacing) solid.externalForce[p] = Vec3(0, 0, -100e3 * lattice.spacing * lattice.spacing);
 	SolverSettings s;
-	s.gravity = Vec3::Zero();
+	s.gravity        = Vec3::Zero();
+	s.darcySubscales = false; // the storage is the matter here, not the stabilisation: the node count passes its maximum within the 11 steps with the plain projection (measured), not with the subscales (eq. 8.6c)
 	TwoPhaseSolver solver(fixtures::columnDomain(size, h), s);
 	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
 	const Real            dt  = 0.5 * solver.timeStepLimits().critical;
