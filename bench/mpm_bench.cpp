@@ -153,6 +153,7 @@ int main(int argc, char** argv)
 	if (corrected) label += "2 corrections ";
 	if (linear) label += "linear ";
 	if (uncached) label += "uncached ";
+	if (plain) label += "plain ";
 	auto         after   = solver.stageSeconds();
 	double       total   = 0;
 	for (int i = 0; i < static_cast<int>(Stage::Count); ++i) total += after[i] - before[i];

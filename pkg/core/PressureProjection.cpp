@@ -122,55 +122,103 @@ namespace {
 		return true;
 	}
 
-	// Eq. 8.6b's S at one point beyond the ∇S_J·∇S_K part that addPairTerms adds with the conductance:
+	// Eq. 8.6b's S beyond the ∇S_J·∇S_K part that addPairTerms adds with the conductance, per point
 	// weight × (G_J·G_K − ∇S_J·∇S_K) = weight × (H_J·H_K − ∇S_J·H_K − H_J·∇S_K), H_J = ∇N_J(x_c) on the
-	// cell's eight nodes and 0 elsewhere, so only the pairs with a node of the cell count: each stencil
-	// node against the eight (a pair of two cell nodes once), written in the stored upper half of the
-	// row of the pair's first node in the stencil's order (written so, without the cancelling
-	// G_J·G_K − ∇S_J·∇S_K, it is also exact where H is small against ∇S)
-	template <int S>
-	inline void addFluctuationPairs(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const int (&node)[3][S], const Vec3 (&dN)[S][S][S],
-	                                Real weight, const PressureSystem& system, Real* rows)
+	// cell's eight nodes and 0 elsewhere (written so, without the cancelling G_J·G_K − ∇S_J·∇S_K, it is
+	// also exact where H is small against ∇S). H is the same for every point of a cell, so the points'
+	// shares are summed per cell first, W = Σ weight and D_J = Σ weight ∇S_J over the union of their
+	// stencils (a box of 2S − 2 nodes per axis), and each cell writes W H_J·H_K − D_J·H_K − H_J·D_K once
+	// for the pairs with a node of the cell: at 2 points per cell and axis 8 points' pair updates become
+	// one cell's. Each pair is written in the stored upper half of the row of its first node in the box's
+	// (z, y, x) order, as the stencil's. `system.fluctuationWeight` holds the points' weights (0: none).
+	template <class Kernel> void addFluctuationPairsByCell(const GridGeometry& grid, const WaterPointSet& P, PressureSystem& system)
 	{
-		int corner[3];
-		if (!cellCornerInStencil<S>(grid, position, w, corner)) return;
-		int row[S][S][S];
-		for (int c = 0; c < S; ++c)
-			for (int b = 0; b < S; ++b)
-				for (int a = 0; a < S; ++a) row[c][b][a] = system.row[grid.index(node[0][a], node[1][b], node[2][c])];
+		constexpr int S = Kernel::stencil, U = 2 * S - 2, inner = S - 2; // box nodes per axis; the cell's lower node in the box
+		const std::vector<Real>& weight = system.fluctuationWeight;
+		// the weighted points grouped by cell (counting sort on the cell's lower node)
+		const std::size_t        nodes = grid.nodeCount(), none = nodes;
+		std::vector<std::size_t> cellKey(P.size(), none), start(nodes + 1, 0);
+		for (std::size_t p = 0; p < P.size(); ++p)
+			if (weight[p] > 0) {
+				const std::array<int, 3> cell = cellOf(grid, P.position[p]);
+				cellKey[p]                    = grid.index(cell[0], cell[1], cell[2]);
+				++start[cellKey[p] + 1];
+			}
+		system.occupiedCellNode.clear();
+		system.cellPointStart.clear();
+		for (std::size_t I = 0; I < nodes; ++I) {
+			if (start[I + 1] > 0) system.occupiedCellNode.push_back(I), system.cellPointStart.push_back(start[I]);
+			start[I + 1] += start[I];
+		}
+		system.cellPointStart.push_back(start[nodes]);
+		system.cellPoints.resize(start[nodes]);
+		for (std::size_t p = 0; p < P.size(); ++p)
+			if (cellKey[p] != none) system.cellPoints[start[cellKey[p]]++] = p;
 		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
-		auto linear = [](int a, int b, int c) { return a + S * (b + S * c); };
-		for (int k = 0; k < 2; ++k)
-			for (int j = 0; j < 2; ++j)
-				for (int i = 0; i < 2; ++i) {
-					const int  ak = corner[0] + i, bk = corner[1] + j, ck = corner[2] + k;
-					const int  rowK = row[ck][bk][ak];
-					if (rowK < 0) continue;
-					const Vec3 HK = centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
-					const Vec3& dNK = dN[ck][bk][ak];
-					const int  lK = linear(ak, bk, ck);
-					for (int c = 0; c < S; ++c)
-						for (int b = 0; b < S; ++b)
-							for (int a = 0; a < S; ++a) {
-								const int rowJ = row[c][b][a];
-								if (rowJ < 0) continue;
-								const int  iJ = a - corner[0], jJ = b - corner[1], kJ = c - corner[2];
-								const bool cellJ = iJ >= 0 && iJ <= 1 && jJ >= 0 && jJ <= 1 && kJ >= 0 && kJ <= 1;
-								const int  lJ = linear(a, b, c);
-								if (cellJ && lJ > lK) continue; // two cell nodes: once, from the later one's turn
-								Real value;
-								if (lJ == lK) value = HK.dot(HK) - 2 * dNK.dot(HK);
-								else {
-									value = -dN[c][b][a].dot(HK);
+		auto       boxIndex = [](int a, int b, int c) { return a + U * (b + U * c); };
+		scatter(system.rows, system.rowBuffers, system.occupiedCellNode.size(), [&](std::size_t occupied, Real* rows) {
+			const std::array<int, 3> cell = grid.indices(system.occupiedCellNode[occupied]);
+			Vec3                     D[U * U * U];
+			bool                     touched[U * U * U] = {};
+			Real                     W = 0;
+			for (std::size_t q = system.cellPointStart[occupied]; q < system.cellPointStart[occupied + 1]; ++q) {
+				const std::size_t p = system.cellPoints[q];
+				Weights1D         w[3];
+				weightsAt<Kernel>(grid, P, p, w);
+				int  shift[3]; // box index of the stencil's first node
+				bool inStencil = true;
+				for (int d = 0; d < 3; ++d) {
+					const int corner = cell[d] - w[d].first; // the cell's lower node in the stencil
+					inStencil        = inStencil && corner >= 0 && corner + 1 < S;
+					shift[d]         = inner - corner;
+				}
+				if (!inStencil) continue; // a point off the grid's cells: no S (eq. 8.6b's G is undefined there)
+				const Real wp = weight[p];
+				W += wp;
+				for (int c = 0; c < S; ++c)
+					for (int b = 0; b < S; ++b)
+						for (int a = 0; a < S; ++a) {
+							const int l = boxIndex(a + shift[0], b + shift[1], c + shift[2]);
+							const Vec3 dN(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
+							              w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
+							D[l]       = touched[l] ? Vec3(D[l] + wp * dN) : Vec3(wp * dN);
+							touched[l] = true;
+						}
+			}
+			if (!(W > 0)) return;
+			int row[U * U * U];
+			for (int c = 0; c < U; ++c)
+				for (int b = 0; b < U; ++b)
+					for (int a = 0; a < U; ++a) {
+						const int l = boxIndex(a, b, c);
+						row[l]      = touched[l] ? system.row[grid.index(grid.wrap(0, cell[0] - inner + a), grid.wrap(1, cell[1] - inner + b), grid.wrap(2, cell[2] - inner + c))] : -1;
+					}
+			for (int k = 0; k < 2; ++k)
+				for (int j = 0; j < 2; ++j)
+					for (int i = 0; i < 2; ++i) {
+						const int ak = inner + i, bk = inner + j, ck = inner + k, lK = boxIndex(ak, bk, ck);
+						const int rowK = row[lK];
+						if (rowK < 0) continue;
+						const Vec3  HK = centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
+						const Vec3& DK = D[lK];
+						for (int c = 0; c < U; ++c)
+							for (int b = 0; b < U; ++b)
+								for (int a = 0; a < U; ++a) {
+									const int lJ = boxIndex(a, b, c), rowJ = row[lJ];
+									if (rowJ < 0) continue;
+									const int  iJ = a - inner, jJ = b - inner, kJ = c - inner;
+									const bool cellJ = iJ >= 0 && iJ <= 1 && jJ >= 0 && jJ <= 1 && kJ >= 0 && kJ <= 1;
+									if (cellJ && lJ > lK) continue; // two cell nodes: once, from the later one's turn
+									Real value = -D[lJ].dot(HK);
 									if (cellJ) {
 										const Vec3 HJ = centre * Vec3(2 * iJ - 1, 2 * jJ - 1, 2 * kJ - 1);
-										value += HJ.dot(HK) - dNK.dot(HJ);
+										value += W * HJ.dot(HK) - DK.dot(HJ);
 									}
+									if (lJ <= lK) rows[static_cast<std::size_t>(rowJ) * PressureSystem::rowStride + upperSlot(ak - a, bk - b, ck - c)] += value;
+									else rows[static_cast<std::size_t>(rowK) * PressureSystem::rowStride + upperSlot(a - ak, b - bk, c - ck)] += value;
 								}
-								if (lJ <= lK) rows[static_cast<std::size_t>(rowJ) * PressureSystem::rowStride + upperSlot(ak - a, bk - b, ck - c)] += weight * value;
-								else rows[static_cast<std::size_t>(rowK) * PressureSystem::rowStride + upperSlot(a - ak, b - bk, c - ck)] += weight * value;
-							}
-				}
+					}
+		});
 	}
 
 	// At one point of stencil `node`: the weight gradients ∇S_J, and the nodes' c κ/μw (`darcy`) and
@@ -563,6 +611,7 @@ namespace stages {
 		const Real invKw = 1 / water.bulkModulus; // 0 for incompressible water (Kw = ∞)
 		for (std::size_t s = 0; s < sets.size(); ++s) {
 			const WaterPointSet& P     = *sets[s];
+			system.fluctuationWeight.resize(P.size());
 			scatter(system.rows, system.rowBuffers, P.size(), [&](std::size_t p, Real* rows) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
@@ -613,7 +662,7 @@ namespace stages {
 							     PressureSystem::rhsSlot] += N[c][b][a] * (stored - V * divergence) + V * relativeFlux.dot(dN[c][b][a]);
 						}
 				addPairTerms<S>(grid, w, node, storage, conductance, system, rows);
-				if (darcy > 0) addFluctuationPairs<S>(grid, P.position[p], w, node, dN, V * darcy, system, rows);
+				system.fluctuationWeight[p] = darcy > 0 ? V * darcy : 0; // eq. 8.6b/c's pairs: per cell, after this pass
 				if (memory > 0 && P.subscaleFlux[p] != Vec3::Zero()) { // exactly: a clay's flux of 1e-13 m/s counts too // + V G_J·(memory q′^n): the subscale flux's divergence it keeps
 					Vec3 G[S][S][S];
 					int  corner[3];
@@ -628,6 +677,7 @@ namespace stages {
 					}
 				}
 			});
+			if (stabilised || system.dynamicSubscales) addFluctuationPairsByCell<Kernel>(grid, P, system);
 		}
 		// the solid's share of the volume balance, (1 − n)∇·vs − vs·∇n, at the solid points (eq. 8.2):
 		// each phase's terms are integrated with its own points, so the volume change the constraint
