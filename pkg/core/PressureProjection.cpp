@@ -137,7 +137,10 @@ namespace {
 		const std::vector<Real>& weight = system.fluctuationWeight;
 		// the weighted points grouped by cell (counting sort on the cell's lower node)
 		const std::size_t        nodes = grid.nodeCount(), none = nodes;
-		std::vector<std::size_t> cellKey(P.size(), none), start(nodes + 1, 0);
+		std::vector<std::size_t>& cellKey = system.cellOfPoint;  // kept from step to step, as the rows
+		std::vector<std::size_t>& start   = system.pointsBefore;
+		assignKeepingStorage(cellKey, P.size(), none);
+		assignKeepingStorage(start, nodes + 1, std::size_t { 0 });
 		for (std::size_t p = 0; p < P.size(); ++p)
 			if (weight[p] > 0) {
 				const std::array<int, 3> cell = cellOf(grid, P.position[p]);

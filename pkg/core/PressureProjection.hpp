@@ -84,6 +84,8 @@ struct PressureSystem {
 	std::vector<std::size_t> cellPointStart;    // per occupied cell: where its points start in cellPoints (and the end after the last)
 	std::vector<std::size_t> cellPoints;        // the points with fluctuationWeight > 0, grouped by cell
 	std::vector<std::size_t> occupiedCellNode;  // per occupied cell: the grid node at its lower corner
+	std::vector<std::size_t> cellOfPoint;       // per water point: its cell's lower node, or nodeCount() where it has no weight (the grouping's scratch)
+	std::vector<std::size_t> pointsBefore;      // per grid node + 1: the weighted points in the cells before it (the grouping's scratch)
 	std::vector<Real>        nodalPressure;   // per grid node: p^{n+1}, 0 off the pressure nodes [Pa]
 	std::vector<Vec3>        mobility;        // per grid node and axis: λ of eq. 8.5 with the walls' holds [m³ kg⁻¹]
 	bool                     dynamicSubscales = false; // eq. 8.6c: S with the instantaneous weight and each water point's subscale flux carried from step to step
