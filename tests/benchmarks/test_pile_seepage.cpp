@@ -36,6 +36,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <vector>
 
 namespace {
@@ -289,6 +290,80 @@ TEST(PileSeepage, PressureUnderAConstantHeadAtTheCrestIsTheLaplaceSolution) { ex
 // 0.19, where the step's own share s alone would be 0.19 of it).
 TEST(PileSeepage, WithDarcySubscalesThePressureIsStillTheLaplaceSolution) { expectPileSeepageIsTheLaplaceSolution(true); }
 
+// The screened slab of the two studies below: 0.30 × 0.12 m, one cell thick, k = 1e-3 m/s, E = 20 MPa,
+// Kw = 2.2e8 Pa, its top a capillary surface, the inflow face x = 0 drained below its table H (capillary
+// above), the far face held at the head `outflowHead` (or, with MPM_SCREEN_SEEPAGE_FACE=1, a seepage face),
+// from a Dupuit-like start the steady state forgets. MPM_SCREEN_PLAIN=1 runs the plain projection,
+// MPM_SCREEN_DARCY_STABILISATION=c eq. 8.6b's quasi-static form (both with the dynamic subscales off).
+struct ScreenedSlab {
+	static constexpr double g = 9.81, L = 0.30, D = 0.12, k = 1e-3;
+	SoilParameters          soil;
+	WaterParameters         water;
+	SolidPointSet           solid;
+	WaterPointSet           fluid;
+	Domain                  domain;
+	std::unique_ptr<TwoPhaseSolver> solver;
+	double                  gammaW = 0;
+
+	ScreenedSlab(double h, double H, double outflowHead)
+	{
+		soil.youngModulus          = 2e7;
+		soil.porosity              = 0.4;
+		water.bulkModulus          = 2.2e8;
+		soil.intrinsicPermeability = k * water.viscosity / (water.density * g);
+		gammaW                     = water.density * g;
+		const double k0 = soil.poissonRatio / (1 - soil.poissonRatio), rhoSat = (1 - soil.porosity) * soil.density + soil.porosity * water.density;
+		const auto   l  = fixtures::lattice(Vec3::Zero(), Vec3(L, h, D), h, 2);
+		solid           = fixtures::solidLattice(l, soil.porosity, soil.density);
+		fluid           = fixtures::waterLattice(l, soil.porosity, water.density);
+		auto start      = [&](double x) { return H * std::sqrt(1 - x / L); };
+		for (std::size_t p = 0; p < solid.size(); ++p) {
+			const Vec3   x  = solid.position[p];
+			const double sz = -rhoSat * g * (D - x.z()) + gammaW * (start(x.x()) - x.z());
+			solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
+			fluid.porePressure[p] = gammaW * (start(x.x()) - x.z());
+		}
+		domain.upper    = Vec3(L, h, D + 2 * h);
+		domain.cellSize = h;
+		for (int f = 0; f < 4; ++f) domain.boundaries.walls[f] = { SolidWall::Slip, WaterWall::Impermeable };
+		domain.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
+		domain.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Impermeable };
+		fixtures::reservoirFace(domain, Face::XMin, H, true);
+		fixtures::reservoirFace(domain, Face::XMax, D, false);
+		domain.boundaries.walls[static_cast<int>(Face::XMax)].drainedPressure = gammaW * (outflowHead - D);
+		if (std::getenv("MPM_SCREEN_SEEPAGE_FACE")) fixtures::reservoirFace(domain, Face::XMax, 0.0, false);
+		SolverSettings s;
+		if (const char* c = std::getenv("MPM_SCREEN_DARCY_STABILISATION")) s.darcyStabilisation = std::atof(c), s.darcySubscales = false;
+		if (std::getenv("MPM_SCREEN_PLAIN")) s.darcySubscales = false;
+		s.gravity          = Vec3(0, 0, -g);
+		s.capillarySurface = true;
+		solver             = std::make_unique<TwoPhaseSolver>(domain, s);
+		solver->setPoints({ SolidSet { &solid, soil, false, SkeletonModel::LinearElastic, StrengthParameters {} } }, { &fluid }, water);
+	}
+	// the water points' Σ V n v_x over a band one cell wide about x, per unit width and height [m²/s]
+	double throughFlow(double x) const
+	{
+		const double h    = domain.cellSize;
+		double       flux = 0;
+		for (std::size_t p = 0; p < fluid.size(); ++p)
+			if (std::abs(fluid.position[p].x() - x) < h / 2) flux += fluid.volume[p] * fluid.porosity[p] * fluid.velocity[p].x();
+		return flux / (h * h);
+	}
+	// the water points' head, weighted by a hat of half a cell about (x, z) [m]
+	double headAt(double x, double z) const
+	{
+		const double h = domain.cellSize;
+		double       sum = 0, weight = 0;
+		for (std::size_t p = 0; p < fluid.size(); ++p) {
+			const Vec3   y = fluid.position[p];
+			const double w = std::max(0.0, 1 - std::abs(y.x() - x) / (h / 2)) * std::max(0.0, 1 - std::abs(y.z() - z) / (h / 2));
+			sum += w * (y.z() + fluid.porePressure[p] / gammaW);
+			weight += w;
+		}
+		return weight > 0 ? sum / weight : NAN;
+	}
+};
+
 // Not a test: the screened inflow face (theory.md §8 Open). A saturated slab L = 0.30 m long, D = 0.12 m
 // deep (the pile's height), one cell thick, k = 1e-3 m/s, E = 20 MPa, Kw = 2.2e8 Pa (the pile's), its
 // top a capillary surface (theory.md eq. 8.5e) two cells below the domain's top, the inflow face x = 0
@@ -305,10 +380,10 @@ TEST(PileSeepage, WithDarcySubscalesThePressureIsStillTheLaplaceSolution) { expe
 //   mpm_benchmark_tests --gtest_also_run_disabled_tests --gtest_filter=ScreenedInflowFace.DISABLED_Study
 TEST(ScreenedInflowFace, DISABLED_Study)
 {
-	const double g = 9.81, L = 0.30, D = 0.12, k = 1e-3, H = 0.03, outflowHead = 0.01;
+	const double k = ScreenedSlab::k, H = 0.03, outflowHead = 0.01;
 	const char*  factorText = std::getenv("MPM_SCREEN_STEP_FACTOR");
 	const double stepFactor = factorText ? std::atof(factorText) : 0.5;
-	const ScreenedSlabHead reference(L, D, H, outflowHead, 0.001);
+	const ScreenedSlabHead reference(ScreenedSlab::L, ScreenedSlab::D, H, outflowHead, 0.001);
 	const double        xs[] = { 0.0025, 0.0075, 0.0125, 0.025, 0.05, 0.1, 0.2, 0.28 }, rows[] = { 0.0175, 0.06 };
 	std::printf("screened slab, steady (ScreenedSlabHead, 1 mm): inflow %.3e, outflow %.3e m²/s\n", reference.discharge(k, 0), reference.discharge(k, reference.nx));
 	for (double z : rows) {
@@ -317,44 +392,10 @@ TEST(ScreenedInflowFace, DISABLED_Study)
 		std::printf("\n");
 	}
 	for (double h : { 0.02, 0.01 }) {
-		SoilParameters  soil;
-		WaterParameters water;
-		soil.youngModulus          = 2e7;
-		soil.porosity              = 0.4;
-		water.bulkModulus          = 2.2e8;
-		soil.intrinsicPermeability = k * water.viscosity / (water.density * g);
-		const double gammaW = water.density * g, k0 = soil.poissonRatio / (1 - soil.poissonRatio);
-		const double rhoSat = (1 - soil.porosity) * soil.density + soil.porosity * water.density;
-		const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(L, h, D), h, 2);
-		SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
-		WaterPointSet fluid = fixtures::waterLattice(l, soil.porosity, water.density);
-		auto          start = [&](double x) { return H * std::sqrt(1 - x / L); }; // a Dupuit-like start; the steady state forgets it
-		for (std::size_t p = 0; p < solid.size(); ++p) {
-			const Vec3   x  = solid.position[p];
-			const double sz = -rhoSat * g * (D - x.z()) + gammaW * (start(x.x()) - x.z());
-			solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
-			fluid.porePressure[p] = gammaW * (start(x.x()) - x.z());
-		}
-		Domain d;
-		d.upper    = Vec3(L, h, D + 2 * h);
-		d.cellSize = h;
-		for (int f = 0; f < 4; ++f) d.boundaries.walls[f] = { SolidWall::Slip, WaterWall::Impermeable };
-		d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
-		d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Impermeable };
-		fixtures::reservoirFace(d, Face::XMin, H, true);
-		fixtures::reservoirFace(d, Face::XMax, D, false);
-		d.boundaries.walls[static_cast<int>(Face::XMax)].drainedPressure = gammaW * (outflowHead - D);
-		if (std::getenv("MPM_SCREEN_SEEPAGE_FACE")) fixtures::reservoirFace(d, Face::XMax, 0.0, false);
-		SolverSettings s;
-		if (const char* c = std::getenv("MPM_SCREEN_DARCY_STABILISATION")) s.darcyStabilisation = std::atof(c), s.darcySubscales = false;
-		if (std::getenv("MPM_SCREEN_PLAIN")) s.darcySubscales = false;
-		s.gravity          = Vec3(0, 0, -g);
-		s.scheme           = TimeScheme::SemiImplicit;
-		s.capillarySurface = true;
-		TwoPhaseSolver solver(d, s);
-		solver.setPoints({ SolidSet { &solid, soil, false, SkeletonModel::LinearElastic, StrengthParameters {} } }, { &fluid }, water);
-		double time  = 0;
-		auto   runTo = [&](double t) {
+		ScreenedSlab    slab(h, H, outflowHead);
+		TwoPhaseSolver& solver = *slab.solver;
+		double          time   = 0;
+		auto            runTo  = [&](double t) {
 			const double dt    = stepFactor * solver.timeStepLimits().critical;
 			const long   steps = static_cast<long>(std::ceil((t - time) / dt - 1e-9));
 			for (long i = 0; i < steps; ++i) solver.step((t - time) / (steps - i)), time += (t - time) / (steps - i);
@@ -364,27 +405,13 @@ TEST(ScreenedInflowFace, DISABLED_Study)
 		const double injected0 = solver.injectedWaterMass(), window = 0.1;
 		runTo(0.3 + window);
 		std::printf("MPM, h = %.3f m, sub-step %.2f of the critical one: inflow %.3e m²/s (as points over %.1f s)\n", h, stepFactor,
-		            (solver.injectedWaterMass() - injected0) / (water.density * h * window), window);
-		// the through-flow the water points carry across sections: Σ V n v_x over a band one cell wide (the
-		// injection above misses what the face's rows lose upwards along the face until a row is refilled)
-		for (double x : { 0.05, 0.15 }) {
-			double flux = 0;
-			for (std::size_t p = 0; p < fluid.size(); ++p)
-				if (std::abs(fluid.position[p].x() - x) < h / 2) flux += fluid.volume[p] * fluid.porosity[p] * fluid.velocity[p].x();
-			std::printf("  through-flow at x = %.2f m: %.3e m²/s\n", x, flux / (h * h));
-		}
+		            (solver.injectedWaterMass() - injected0) / (slab.water.density * h * window), window);
+		// the through-flow the water points carry across sections (the injection above misses what the
+		// face's rows lose upwards along the face until a row is refilled)
+		for (double x : { 0.05, 0.15 }) std::printf("  through-flow at x = %.2f m: %.3e m²/s\n", x, slab.throughFlow(x));
 		for (double z : rows) {
 			std::printf("  z = %.4f m, head:", z);
-			for (double x : xs) { // the water points' heads, weighted by a hat of half a cell about (x, z)
-				double sum = 0, weight = 0;
-				for (std::size_t p = 0; p < fluid.size(); ++p) {
-					const Vec3   y = fluid.position[p];
-					const double w = std::max(0.0, 1 - std::abs(y.x() - x) / (h / 2)) * std::max(0.0, 1 - std::abs(y.z() - z) / (h / 2));
-					sum += w * (y.z() + fluid.porePressure[p] / gammaW);
-					weight += w;
-				}
-				std::printf(" %.4f", weight > 0 ? sum / weight : NAN);
-			}
+			for (double x : xs) std::printf(" %.4f", slab.headAt(x, z));
 			std::printf("\n");
 		}
 	}
@@ -400,46 +427,15 @@ TEST(ScreenedInflowFace, DISABLED_Study)
 //   mpm_benchmark_tests --gtest_also_run_disabled_tests --gtest_filter=ScreenedInflowFace.DISABLED_TableRisingThroughANodePlane
 TEST(ScreenedInflowFace, DISABLED_TableRisingThroughANodePlane)
 {
-	const double g = 9.81, L = 0.30, D = 0.12, k = 1e-3, H0 = 0.03, H1 = 0.05, outflowHead = 0.01, settle = 0.3, rise = 2.0;
+	const double H0 = 0.03, H1 = 0.05, outflowHead = 0.01, settle = 0.3, rise = 2.0, probeX = 0.05, probeZ = 0.0175;
 	const char*  cellText = std::getenv("MPM_SCREEN_CELL");
 	const double h        = cellText ? std::atof(cellText) : 0.02;
-	SoilParameters  soil;
-	WaterParameters water;
-	soil.youngModulus          = 2e7;
-	soil.porosity              = 0.4;
-	water.bulkModulus          = 2.2e8;
-	soil.intrinsicPermeability = k * water.viscosity / (water.density * g);
-	const double gammaW = water.density * g, k0 = soil.poissonRatio / (1 - soil.poissonRatio);
-	const double rhoSat = (1 - soil.porosity) * soil.density + soil.porosity * water.density;
-	const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(L, h, D), h, 2);
-	SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
-	WaterPointSet fluid = fixtures::waterLattice(l, soil.porosity, water.density);
-	auto          start = [&](double x) { return H0 * std::sqrt(1 - x / L); };
-	for (std::size_t p = 0; p < solid.size(); ++p) {
-		const Vec3   x  = solid.position[p];
-		const double sz = -rhoSat * g * (D - x.z()) + gammaW * (start(x.x()) - x.z());
-		solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
-		fluid.porePressure[p] = gammaW * (start(x.x()) - x.z());
-	}
-	Domain d;
-	d.upper    = Vec3(L, h, D + 2 * h);
-	d.cellSize = h;
-	for (int f = 0; f < 4; ++f) d.boundaries.walls[f] = { SolidWall::Slip, WaterWall::Impermeable };
-	d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
-	d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Impermeable };
-	fixtures::reservoirFace(d, Face::XMin, H0, true);
-	fixtures::reservoirFace(d, Face::XMax, D, false);
-	d.boundaries.walls[static_cast<int>(Face::XMax)].drainedPressure = gammaW * (outflowHead - D);
-	SolverSettings s;
-	if (std::getenv("MPM_SCREEN_PLAIN")) s.darcySubscales = false;
-	s.gravity          = Vec3(0, 0, -g);
-	s.capillarySurface = true;
-	TwoPhaseSolver solver(d, s);
-	solver.setPoints({ SolidSet { &solid, soil, false, SkeletonModel::LinearElastic, StrengthParameters {} } }, { &fluid }, water);
-	const double dt   = 0.5 * solver.timeStepLimits().critical;
-	double       time = 0;
-	auto         table = [&](double t) { return t <= settle ? H0 : H0 + (H1 - H0) * std::min(1.0, (t - settle) / rise); };
-	const double probeX = 0.05, probeZ = 0.0175;
+	ScreenedSlab    slab(h, H0, outflowHead);
+	TwoPhaseSolver& solver = *slab.solver;
+	Domain&         d      = slab.domain;
+	const double    dt     = 0.5 * solver.timeStepLimits().critical;
+	double          time   = 0;
+	auto            table  = [&](double t) { return t <= settle ? H0 : H0 + (H1 - H0) * std::min(1.0, (t - settle) / rise); };
 	std::printf("h = %.3f m: t [s], table [m], through-flow at x = %.2f m [m²/s] / steady, head at (%.2f, %.4f) m / steady\n", h, probeX, probeX, probeZ);
 	for (int record = 1; record <= static_cast<int>(std::lround((settle + rise) / 0.1)); ++record) {
 		const double t = 0.1 * record;
@@ -451,17 +447,10 @@ TEST(ScreenedInflowFace, DISABLED_TableRisingThroughANodePlane)
 			time += step;
 		}
 		if (t < settle - 1e-9) continue;
-		const ScreenedSlabHead reference(L, D, table(t), outflowHead, 0.002);
-		double flux = 0, sum = 0, weight = 0;
-		for (std::size_t p = 0; p < fluid.size(); ++p) {
-			const Vec3 y = fluid.position[p];
-			if (std::abs(y.x() - probeX) < h / 2) flux += fluid.volume[p] * fluid.porosity[p] * fluid.velocity[p].x();
-			const double w = std::max(0.0, 1 - std::abs(y.x() - probeX) / (h / 2)) * std::max(0.0, 1 - std::abs(y.z() - probeZ) / (h / 2));
-			sum += w * (y.z() + fluid.porePressure[p] / gammaW);
-			weight += w;
-		}
-		std::printf("  %.2f %.4f %.3e / %.3e (%+.1f%%) %.4f / %.4f\n", t, table(t), flux / (h * h), reference.discharge(k, 0),
-		            100 * (flux / (h * h) / reference.discharge(k, 0) - 1), weight > 0 ? sum / weight : NAN, reference.at(probeX, probeZ));
+		const ScreenedSlabHead reference(ScreenedSlab::L, ScreenedSlab::D, table(t), outflowHead, 0.002);
+		const double           flow = slab.throughFlow(probeX), steady = reference.discharge(ScreenedSlab::k, 0);
+		std::printf("  %.2f %.4f %.3e / %.3e (%+.1f%%) %.4f / %.4f\n", t, table(t), flow, steady, 100 * (flow / steady - 1), slab.headAt(probeX, probeZ),
+		            reference.at(probeX, probeZ));
 	}
 }
 
