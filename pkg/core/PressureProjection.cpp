@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 #include <utility>
 
@@ -163,6 +164,7 @@ namespace {
 			const std::array<int, 3> cell = grid.indices(system.occupiedCellNode[occupied]);
 			Vec3                     D[U * U * U];
 			bool                     touched[U * U * U] = {};
+			for (Vec3& v : D) v.setZero();
 			Real                     W = 0;
 			for (std::size_t q = system.cellPointStart[occupied]; q < system.cellPointStart[occupied + 1]; ++q) {
 				const std::size_t p = system.cellPoints[q];
@@ -184,7 +186,7 @@ namespace {
 							const int l = boxIndex(a + shift[0], b + shift[1], c + shift[2]);
 							const Vec3 dN(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
 							              w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
-							D[l]       = touched[l] ? Vec3(D[l] + wp * dN) : Vec3(wp * dN);
+							D[l] += wp * dN;
 							touched[l] = true;
 						}
 			}
@@ -666,7 +668,9 @@ namespace stages {
 						}
 				addPairTerms<S>(grid, w, node, storage, conductance, system, rows);
 				system.fluctuationWeight[p] = darcy > 0 ? V * darcy : 0; // eq. 8.6b/c's pairs: per cell, after this pass
-				if (memory > 0 && P.subscaleFlux[p] != Vec3::Zero()) { // exactly: a clay's flux of 1e-13 m/s counts too // + V G_J·(memory q′^n): the subscale flux's divergence it keeps
+				// + V G_J·(memory q′^n): the divergence of the subscale flux the point keeps (tested for an exact
+				// zero: a clay's flux of 1e-13 m/s counts too)
+				if (memory > 0 && P.subscaleFlux[p] != Vec3::Zero()) {
 					Vec3 G[S][S][S];
 					int  corner[3];
 					if (fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner)) {
@@ -680,7 +684,7 @@ namespace stages {
 					}
 				}
 			});
-			if (stabilised || system.dynamicSubscales) addFluctuationPairsByCell<Kernel>(grid, P, system);
+			if (stabilised) addFluctuationPairsByCell<Kernel>(grid, P, system); // the subscales assemble with c = 1
 		}
 		// the solid's share of the volume balance, (1 − n)∇·vs − vs·∇n, at the solid points (eq. 8.2):
 		// each phase's terms are integrated with its own points, so the volume change the constraint
@@ -1018,7 +1022,9 @@ namespace stages {
 			constexpr int S = Kernel::stencil;
 			for (WaterPointSet* set : sets) {
 				WaterPointSet& P = *set;
-				if (P.subscaleFlux.size() != P.size()) P.subscaleFlux.assign(P.size(), Vec3::Zero());
+				// the assembly of this step sized the fluxes and no point came or went since: a mismatch is a bug,
+				// not a state to reset (zeroing would drop every point's carried flux silently)
+				if (P.subscaleFlux.size() != P.size()) throw std::logic_error("accumulatePressureForces: the water points' subscale fluxes were not sized by this step's assembly");
 #pragma omp parallel for schedule(static) if(P.size() > parallelThreshold)
 				for (std::size_t p = 0; p < P.size(); ++p) {
 					Weights1D w[3];

@@ -123,10 +123,14 @@ void SolverSettings::validate() const
 	if (!(pressureCorrections >= 0 && pressureCorrections <= maxPressureCorrections)) throwOutOfRange("pressureCorrections", pressureCorrections, "", "[0, " + std::to_string(maxPressureCorrections) + "]");
 	if (!(darcyStabilisation >= 0 && darcyStabilisation <= maxDarcyStabilisation)) throwOutOfRange("darcyStabilisation", darcyStabilisation, "", "[0, " + std::to_string(static_cast<int>(maxDarcyStabilisation)) + "]");
 	// the explicit scheme has no pressure system: it ignores darcySubscales (on by default) and eq. 8.6b's c alike
-	if (scheme == TimeScheme::SemiImplicit && darcySubscales && darcyStabilisation > 0)
-		throw InvalidParameter("darcyStabilisation = " + std::to_string(darcyStabilisation) +
-		                       " is eq. 8.6b's quasi-static weight, but darcySubscales = True (the default) sets the stabilisation's weight itself (theory.md eq. 8.6c): "
-		                       "set darcySubscales = False with darcyStabilisation in (0, " + std::to_string(static_cast<int>(maxDarcyStabilisation)) + "], or darcyStabilisation = 0");
+	if (scheme == TimeScheme::SemiImplicit && darcySubscales && darcyStabilisation > 0) {
+		std::ostringstream msg; // the value as the user wrote it (1, not 1.000000), as throwOutOfRange prints it
+		msg << "darcyStabilisation = " << darcyStabilisation
+		    << " is eq. 8.6b's quasi-static weight, but darcySubscales = True (the default) sets the stabilisation's weight itself (theory.md eq. 8.6c): "
+		       "set darcySubscales = False with darcyStabilisation in (0, "
+		    << maxDarcyStabilisation << "], or darcyStabilisation = 0";
+		throw InvalidParameter(msg.str());
+	}
 	if (!(maxSubSteps >= 1)) throwOutOfRange("maxSubSteps", maxSubSteps, "", "[1, inf)");
 	if (!(inertiaScale >= 1 && std::isfinite(inertiaScale))) throwOutOfRange("inertiaScale", inertiaScale, "", "[1, inf)");
 	if (!(inertiaScaleRelease > 0)) throwOutOfRange("inertiaScaleRelease", inertiaScaleRelease, "", "(0, inf]");

@@ -26,7 +26,7 @@ struct SolverSettings {
 	bool          pressureModeDamping        = false; // eqs. 4.17b–c (explicit scheme only): pressure modes the grid cannot see decay as a one-cell seepage would
 	Real          pressureTolerance          = 1e-3;  // δp [Pa] > 0: the semi-implicit pressure solve stops at the residual of a pressure error δp at a typical node (§8.7)
 	long          pressureCorrections        = 0;     // [-] ≥ 0: defect corrections of the semi-implicit pressure towards the exact projection per step (§8.7b)
-	Real          darcyStabilisation         = 0;     // c [-], 0 ≤ c ≤ 10: the semi-implicit projection's local projection stabilisation, c κ/μw on the pressure gradient's departure from its cell mean (eq. 8.6b); 0: none
+	Real          darcyStabilisation         = 0;     // c [-], 0 ≤ c ≤ 10: the semi-implicit projection's local projection stabilisation, c κ/μw on the pressure gradient's departure from its cell mean (eq. 8.6b), with darcySubscales off; 0: none
 	Real          freeSurfaceThreshold       = 0;    // β [-], 0 ≤ β < 1: p = 0 on points filled below β (eq. 2.3); 0: off
 	bool          freeSurfaceHoldsSuction    = false; // eq. 2.3b (explicit scheme only): the surface keeps suction (p < 0) and releases only p > 0
 	bool          darcySubscales             = true;  // eq. 8.6c (semi-implicit scheme; the explicit one has no pressure system and ignores it): eq. 8.6b's flux tracked at the water points as dynamic subscales: S weighted by its response within the step, min(κ/μw, Δt λ), and each point's subscale flux carried to the next step by the water's inertia against its drag; no parameter; false for the unstabilised projection or with darcyStabilisation > 0

@@ -296,7 +296,7 @@ TEST(PileSeepage, WithDarcySubscalesThePressureIsStillTheLaplaceSolution) { expe
 // from a Dupuit-like start the steady state forgets. MPM_SCREEN_PLAIN=1 runs the plain projection,
 // MPM_SCREEN_DARCY_STABILISATION=c eq. 8.6b's quasi-static form (both with the dynamic subscales off).
 struct ScreenedSlab {
-	static constexpr double g = 9.81, L = 0.30, D = 0.12, k = 1e-3;
+	static constexpr double g = 9.81, L = 0.30, D = 0.12, k = 1e-3; // gravity [m s⁻²], length and height [m], hydraulic conductivity [m s⁻¹]
 	SoilParameters          soil;
 	WaterParameters         water;
 	SolidPointSet           solid;

@@ -109,6 +109,7 @@ TEST(DarcySubscales, TheExplicitSchemeIgnoresThemBitForBit)
 {
 	const FinalState on = run(TimeScheme::Explicit, ShapeFunction::UGimp, 1, true, true), off = run(TimeScheme::Explicit, ShapeFunction::UGimp, 1, true, false);
 	ASSERT_EQ(on.water.size(), off.water.size());
+	ASSERT_EQ(on.water.subscaleFlux.size(), on.water.size()); // sized with the points, zero unless tracked
 	for (std::size_t p = 0; p < on.solid.size(); ++p) {
 		ASSERT_EQ(on.solid.position[p], off.solid.position[p]) << "solid point " << p;
 		ASSERT_EQ(on.solid.effectiveStress[p], off.solid.effectiveStress[p]) << "solid point " << p;

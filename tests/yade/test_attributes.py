@@ -92,11 +92,11 @@ def test_darcy_subscales_are_the_default_and_set_their_own_weight():
     # theory.md eq. 8.6c: the dynamic subscales are the semi-implicit default and weight the
     # stabilisation themselves, so a quasi-static weight c (eq. 8.6b) at the same time is refused
     # with both names; the explicit scheme has no pressure system and ignores the switch (its
-    # bit-for-bit equality on and off is tested in the core, ExplicitScheme.IgnoresDarcySubscales)
+    # bit-for-bit equality on and off is tested in the core, DarcySubscales.TheExplicitSchemeIgnoresThemBitForBit)
     assert w.MpmTwoPhaseEngine().darcySubscales is True
     w.MpmTwoPhaseEngine(scheme="explicit", darcySubscales=True)
     w.MpmTwoPhaseEngine(darcySubscales=False, darcyStabilisation=1.0)
-    with pytest.raises(ValueError, match=r"darcyStabilisation = 1.* darcySubscales = True .* set darcySubscales = False"):
+    with pytest.raises(ValueError, match=r"darcyStabilisation = 1 is .* darcySubscales = True .* set darcySubscales = False with darcyStabilisation in \(0, 10\]"):
         w.MpmTwoPhaseEngine(darcyStabilisation=1.0)
 
 
