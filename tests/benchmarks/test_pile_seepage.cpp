@@ -105,7 +105,8 @@ struct LaplaceHead {
 
 // The steady head of a saturated slab [0, L] × [0, D] (the screened inflow face's study below): the face
 // x = 0 open to a reservoir at level H < D below it (h = H) and a capillary surface above it, the face
-// x = L held at a uniform head, the base impermeable, the top a capillary surface (the Signorini
+// x = L held at a uniform head (`outflowHead`) or, with outflowHead NaN, a seepage face (capillary, as the
+// top: the pile's toe), the base impermeable, the top a capillary surface (the Signorini
 // conditions of theory.md eq. 8.5e: h ≤ z, no flux where h < z, outflow where h = z). Conservative finite
 // volumes on the nodes' dual cells (half cells along the box's sides), projected successive
 // over-relaxation (each sweep clamps the capillary nodes to h ≤ z). The same scheme as
@@ -121,6 +122,7 @@ struct ScreenedSlabHead {
 	{
 		nx = static_cast<int>(std::lround(L / dx));
 		nz = static_cast<int>(std::lround(D / dx));
+		const bool seepageFace = std::isnan(outflowHead);
 		head.assign(static_cast<std::size_t>((nx + 1) * (nz + 1)), H);
 		fixed.assign(head.size(), 0);
 		capillary.assign(head.size(), 0);
@@ -128,8 +130,8 @@ struct ScreenedSlabHead {
 			for (int i = 0; i <= nx; ++i) {
 				const double z = j * dx;
 				if (i == 0 && z < H) fixed[id(i, j)] = 1;
-				else if (i == nx) fixed[id(i, j)] = 1, head[id(i, j)] = outflowHead;
-				else if (i == 0 || j == nz) capillary[id(i, j)] = 1, head[id(i, j)] = std::min(H, z);
+				else if (i == nx && !seepageFace) fixed[id(i, j)] = 1, head[id(i, j)] = outflowHead;
+				else if (i == 0 || i == nx || j == nz) capillary[id(i, j)] = 1, head[id(i, j)] = std::min(H, z);
 			}
 		const double omega = 2 / (1 + std::sin(M_PI / nx));
 		for (int sweep = 0; sweep < 400000; ++sweep) {
@@ -304,8 +306,10 @@ struct ScreenedSlab {
 	Domain                  domain;
 	std::unique_ptr<TwoPhaseSolver> solver;
 	double                  gammaW = 0;
+	double                  outflowHead = 0;     // the far face's held head [m]
+	bool                    seepageFace = false; // MPM_SCREEN_SEEPAGE_FACE: the far face a seepage face instead
 
-	ScreenedSlab(double h, double H, double outflowHead)
+	ScreenedSlab(double h, double H, double heldHead) : outflowHead(heldHead), seepageFace(std::getenv("MPM_SCREEN_SEEPAGE_FACE") != nullptr)
 	{
 		soil.youngModulus          = 2e7;
 		soil.porosity              = 0.4;
@@ -331,7 +335,7 @@ struct ScreenedSlab {
 		fixtures::reservoirFace(domain, Face::XMin, H, true);
 		fixtures::reservoirFace(domain, Face::XMax, D, false);
 		domain.boundaries.walls[static_cast<int>(Face::XMax)].drainedPressure = gammaW * (outflowHead - D);
-		if (std::getenv("MPM_SCREEN_SEEPAGE_FACE")) fixtures::reservoirFace(domain, Face::XMax, 0.0, false);
+		if (seepageFace) fixtures::reservoirFace(domain, Face::XMax, 0.0, false);
 		SolverSettings s;
 		if (const char* c = std::getenv("MPM_SCREEN_DARCY_STABILISATION")) s.darcyStabilisation = std::atof(c), s.darcySubscales = false;
 		if (std::getenv("MPM_SCREEN_PLAIN")) s.darcySubscales = false;
@@ -348,6 +352,18 @@ struct ScreenedSlab {
 		for (std::size_t p = 0; p < fluid.size(); ++p)
 			if (std::abs(fluid.position[p].x() - x) < h / 2) flux += fluid.volume[p] * fluid.porosity[p] * fluid.velocity[p].x();
 		return flux / (h * h);
+	}
+	// the steady seepage of the same section and far face for the inflow face's table H, on a grid of `spacing`
+	ScreenedSlabHead steady(double H, double spacing) const { return ScreenedSlabHead(L, D, H, seepageFace ? NAN : outflowHead, spacing); }
+	// Σ n V ρw/m of the water points in the column a cell wide beside the far face: 1 where their volume is
+	// their share of the pores (the rate-form volume of eq. 8.9 has not drifted) [-]
+	double farColumnFilling() const
+	{
+		double sum = 0;
+		int    count = 0;
+		for (std::size_t p = 0; p < fluid.size(); ++p)
+			if (fluid.position[p].x() > L - domain.cellSize) sum += fluid.porosity[p] * fluid.volume[p] * water.density / fluid.mass[p], ++count;
+		return count ? sum / count : NAN;
 	}
 	// the water points' head, weighted by a hat of half a cell about (x, z) [m]
 	double headAt(double x, double z) const
@@ -372,9 +388,8 @@ struct ScreenedSlab {
 // above 1 cm). Against ScreenedSlabHead (the same section's steady seepage): the heads at x = 0.0025…0.28 m in the rows
 // z = 0.0175 and 0.06 m and the discharge. MPM_SCREEN_STEP_FACTOR (default 0.5) sets the sub-step as a
 // fraction of the critical one; MPM_SCREEN_SEEPAGE_FACE=1 makes the face x = L a seepage face (drained
-// below z = 0, capillary above: the pile's toe; its steady through-flow, from
-// yade_mpm.steady_seepage.SteadySeepage(..., outflow_head=None) at 1 mm, is 5.53e-6 m²/s, which the
-// printed reference, the held face's, is not). It runs the default step (theory.md eq. 8.6c's dynamic
+// below z = 0, capillary above: the pile's toe), and the printed reference that face's steady seepage
+// (yade_mpm.steady_seepage.SteadySeepage(..., outflow_head=None) at 1 mm: 5.53e-6 m²/s). It runs the default step (theory.md eq. 8.6c's dynamic
 // subscales); MPM_SCREEN_PLAIN=1 the plain projection, MPM_SCREEN_DARCY_STABILISATION=c eq. 8.6b's
 // quasi-static form (both with the subscales off). About a minute on one core:
 //   mpm_benchmark_tests --gtest_also_run_disabled_tests --gtest_filter=ScreenedInflowFace.DISABLED_Study
@@ -383,7 +398,7 @@ TEST(ScreenedInflowFace, DISABLED_Study)
 	const double k = ScreenedSlab::k, H = 0.03, outflowHead = 0.01;
 	const char*  factorText = std::getenv("MPM_SCREEN_STEP_FACTOR");
 	const double stepFactor = factorText ? std::atof(factorText) : 0.5;
-	const ScreenedSlabHead reference(ScreenedSlab::L, ScreenedSlab::D, H, outflowHead, 0.001);
+	const ScreenedSlabHead reference(ScreenedSlab::L, ScreenedSlab::D, H, std::getenv("MPM_SCREEN_SEEPAGE_FACE") ? NAN : outflowHead, 0.001);
 	const double        xs[] = { 0.0025, 0.0075, 0.0125, 0.025, 0.05, 0.1, 0.2, 0.28 }, rows[] = { 0.0175, 0.06 };
 	std::printf("screened slab, steady (ScreenedSlabHead, 1 mm): inflow %.3e, outflow %.3e m²/s\n", reference.discharge(k, 0), reference.discharge(k, reference.nx));
 	for (double z : rows) {
@@ -421,9 +436,12 @@ TEST(ScreenedInflowFace, DISABLED_Study)
 // face's table rises through a node plane, 0.03 → 0.05 m over 2 s after 0.3 s at 0.03 m (quasi-steady: ten
 // consolidation times take 0.3 s). Every 0.1 s it prints the table, the through-flow at x = 5 cm (Σ V n v_x over
 // a band one cell wide) and the water points' head at (0.05, 0.0175) m, each against the steady seepage of the
-// same table (ScreenedSlabHead, 2 mm). Where the face's drained part ends between node planes the deficit
-// changes in a step as the table crosses one (z = 0.04 m at 1.3 s): what the quick sand pile's onset follows
-// (doc/sandpile.md). MPM_SCREEN_CELL sets h (default 0.02 m). About two minutes on one core at 2 cm:
+// same table (ScreenedSlabHead, 2 mm; MPM_SCREEN_SEEPAGE_FACE=1 makes the far face, and the reference's, a
+// seepage face), and the water the faces pass as points (injected, removed, per unit width) with the far
+// column's Σ nVρw/m (1: the water points fill their pores). Where the face's drained part ends between node
+// planes the deficit changes in a step as the table crosses one (z = 0.04 m at 1.3 s): what the quick sand
+// pile's onset follows (doc/sandpile.md, theory.md §8 Open). MPM_SCREEN_CELL sets h (default 0.02 m). About
+// two minutes on one core at 2 cm:
 //   mpm_benchmark_tests --gtest_also_run_disabled_tests --gtest_filter=ScreenedInflowFace.DISABLED_TableRisingThroughANodePlane
 TEST(ScreenedInflowFace, DISABLED_TableRisingThroughANodePlane)
 {
@@ -436,7 +454,10 @@ TEST(ScreenedInflowFace, DISABLED_TableRisingThroughANodePlane)
 	const double    dt     = 0.5 * solver.timeStepLimits().critical;
 	double          time   = 0;
 	auto            table  = [&](double t) { return t <= settle ? H0 : H0 + (H1 - H0) * std::min(1.0, (t - settle) / rise); };
-	std::printf("h = %.3f m: t [s], table [m], through-flow at x = %.2f m [m²/s] / steady, head at (%.2f, %.4f) m / steady\n", h, probeX, probeX, probeZ);
+	std::printf("h = %.3f m%s: t [s], table [m], through-flow at x = %.2f m [m²/s] / steady, head at (%.2f, %.4f) m / steady, in and out as points [m²/s], "
+	            "far column's Σ nVρw/m\n",
+	            h, slab.seepageFace ? ", far face a seepage face" : "", probeX, probeX, probeZ);
+	double injected = 0, removed = 0; // [kg] at the last record
 	for (int record = 1; record <= static_cast<int>(std::lround((settle + rise) / 0.1)); ++record) {
 		const double t = 0.1 * record;
 		while (time < t - 1e-12) {
@@ -447,10 +468,13 @@ TEST(ScreenedInflowFace, DISABLED_TableRisingThroughANodePlane)
 			time += step;
 		}
 		if (t < settle - 1e-9) continue;
-		const ScreenedSlabHead reference(ScreenedSlab::L, ScreenedSlab::D, table(t), outflowHead, 0.002);
+		const ScreenedSlabHead reference = slab.steady(table(t), 0.002);
 		const double           flow = slab.throughFlow(probeX), steady = reference.discharge(ScreenedSlab::k, 0);
-		std::printf("  %.2f %.4f %.3e / %.3e (%+.1f%%) %.4f / %.4f\n", t, table(t), flow, steady, 100 * (flow / steady - 1), slab.headAt(probeX, probeZ),
-		            reference.at(probeX, probeZ));
+		const double           perWidth = 1 / (slab.water.density * h * 0.1); // kg per record → m²/s
+		std::printf("  %.2f %.4f %.3e / %.3e (%+.1f%%) %.4f / %.4f  in %.2e out %.2e  %.4f\n", t, table(t), flow, steady, 100 * (flow / steady - 1),
+		            slab.headAt(probeX, probeZ), reference.at(probeX, probeZ), (solver.injectedWaterMass() - injected) * perWidth,
+		            (solver.removedWaterMass() - removed) * perWidth, slab.farColumnFilling());
+		injected = solver.injectedWaterMass(), removed = solver.removedWaterMass();
 	}
 }
 
