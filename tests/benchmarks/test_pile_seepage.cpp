@@ -307,9 +307,15 @@ struct ScreenedSlab {
 	std::unique_ptr<TwoPhaseSolver> solver;
 	double                  gammaW = 0;
 	double                  outflowHead = 0;     // the far face's held head [m]
-	bool                    seepageFace = false; // MPM_SCREEN_SEEPAGE_FACE: the far face a seepage face instead
+	bool                    seepageFace = false; // the far face a seepage face instead (seepageFaceAsked)
 
-	ScreenedSlab(double h, double H, double heldHead) : outflowHead(heldHead), seepageFace(std::getenv("MPM_SCREEN_SEEPAGE_FACE") != nullptr)
+	// MPM_SCREEN_SEEPAGE_FACE=1: the far face a seepage face (drained below z = 0, capillary above: the pile's toe)
+	static bool seepageFaceAsked() { return std::getenv("MPM_SCREEN_SEEPAGE_FACE") != nullptr; }
+	// the steady seepage of the section for the inflow face's table H [m], the far face as the slab's, on a grid of
+	// `spacing` [m]
+	static ScreenedSlabHead steady(double H, double heldHead, double spacing) { return ScreenedSlabHead(L, D, H, seepageFaceAsked() ? NAN : heldHead, spacing); }
+
+	ScreenedSlab(double h, double H, double heldHead) : outflowHead(heldHead), seepageFace(seepageFaceAsked())
 	{
 		soil.youngModulus          = 2e7;
 		soil.porosity              = 0.4;
@@ -353,8 +359,6 @@ struct ScreenedSlab {
 			if (std::abs(fluid.position[p].x() - x) < h / 2) flux += fluid.volume[p] * fluid.porosity[p] * fluid.velocity[p].x();
 		return flux / (h * h);
 	}
-	// the steady seepage of the same section and far face for the inflow face's table H, on a grid of `spacing`
-	ScreenedSlabHead steady(double H, double spacing) const { return ScreenedSlabHead(L, D, H, seepageFace ? NAN : outflowHead, spacing); }
 	// Σ n V ρw/m of the water points in the column a cell wide beside the far face: 1 where their volume is
 	// their share of the pores (the rate-form volume of eq. 8.9 has not drifted) [-]
 	double farColumnFilling() const
@@ -398,11 +402,11 @@ TEST(ScreenedInflowFace, DISABLED_Study)
 	const double k = ScreenedSlab::k, H = 0.03, outflowHead = 0.01;
 	const char*  factorText = std::getenv("MPM_SCREEN_STEP_FACTOR");
 	const double stepFactor = factorText ? std::atof(factorText) : 0.5;
-	const ScreenedSlabHead reference(ScreenedSlab::L, ScreenedSlab::D, H, std::getenv("MPM_SCREEN_SEEPAGE_FACE") ? NAN : outflowHead, 0.001);
+	const ScreenedSlabHead reference = ScreenedSlab::steady(H, outflowHead, 0.001);
 	const double        xs[] = { 0.0025, 0.0075, 0.0125, 0.025, 0.05, 0.1, 0.2, 0.28 }, rows[] = { 0.0175, 0.06 };
 	// (the outflow from the held face's fixed nodes; a seepage face has none, and passes the inflow at steady state)
 	std::printf("screened slab, steady (ScreenedSlabHead, 1 mm): inflow %.3e, outflow %.3e m²/s\n", reference.discharge(k, 0),
-	            std::getenv("MPM_SCREEN_SEEPAGE_FACE") ? reference.discharge(k, 0) : reference.discharge(k, reference.nx));
+	            ScreenedSlab::seepageFaceAsked() ? reference.discharge(k, 0) : reference.discharge(k, reference.nx));
 	for (double z : rows) {
 		std::printf("  z = %.4f m, head:", z);
 		for (double x : xs) std::printf(" %.4f", reference.at(x, z));
@@ -447,7 +451,7 @@ TEST(ScreenedInflowFace, DISABLED_Study)
 //   mpm_benchmark_tests --gtest_also_run_disabled_tests --gtest_filter=ScreenedInflowFace.DISABLED_TableRisingThroughANodePlane
 TEST(ScreenedInflowFace, DISABLED_TableRisingThroughANodePlane)
 {
-	const double H0 = 0.03, H1 = 0.05, outflowHead = 0.01, settle = 0.3, rise = 2.0, probeX = 0.05, probeZ = 0.0175;
+	const double H0 = 0.03, H1 = 0.05, outflowHead = 0.01, settle = 0.3, rise = 2.0, every = 0.1, probeX = 0.05, probeZ = 0.0175; // [m], [s], [m]
 	const char*  cellText = std::getenv("MPM_SCREEN_CELL");
 	const double h        = cellText ? std::atof(cellText) : 0.02;
 	ScreenedSlab    slab(h, H0, outflowHead);
@@ -459,9 +463,9 @@ TEST(ScreenedInflowFace, DISABLED_TableRisingThroughANodePlane)
 	std::printf("h = %.3f m%s: t [s], table [m], through-flow at x = %.2f m [m²/s] / steady, head at (%.2f, %.4f) m / steady, in and out as points [m²/s], "
 	            "far column's Σ nVρw/m\n",
 	            h, slab.seepageFace ? ", far face a seepage face" : "", probeX, probeX, probeZ);
-	double injected = 0, removed = 0; // [kg] at the last record
-	for (int record = 1; record <= static_cast<int>(std::lround((settle + rise) / 0.1)); ++record) {
-		const double t = 0.1 * record;
+	double injected = 0, removed = 0; // [kg] at the last record, printed or not
+	for (int record = 1; record <= static_cast<int>(std::lround((settle + rise) / every)); ++record) {
+		const double t = every * record;
 		while (time < t - 1e-12) {
 			const double step = std::min(dt, t - time);
 			d.boundaries.walls[static_cast<int>(Face::XMin)].waterTable = table(time + step); // p̄(t^{n+1})
@@ -469,14 +473,14 @@ TEST(ScreenedInflowFace, DISABLED_TableRisingThroughANodePlane)
 			solver.step(step);
 			time += step;
 		}
-		if (t < settle - 1e-9) continue;
-		const ScreenedSlabHead reference = slab.steady(table(t), 0.002);
-		const double           flow = slab.throughFlow(probeX), steady = reference.discharge(ScreenedSlab::k, 0);
-		const double           perWidth = 1 / (slab.water.density * h * 0.1); // kg per record → m²/s
-		std::printf("  %.2f %.4f %.3e / %.3e (%+.1f%%) %.4f / %.4f  in %.2e out %.2e  %.4f\n", t, table(t), flow, steady, 100 * (flow / steady - 1),
-		            slab.headAt(probeX, probeZ), reference.at(probeX, probeZ), (solver.injectedWaterMass() - injected) * perWidth,
-		            (solver.removedWaterMass() - removed) * perWidth, slab.farColumnFilling());
+		const double in = solver.injectedWaterMass() - injected, out = solver.removedWaterMass() - removed; // [kg] over this record
 		injected = solver.injectedWaterMass(), removed = solver.removedWaterMass();
+		if (t < settle - 1e-9) continue;
+		const ScreenedSlabHead reference = ScreenedSlab::steady(table(t), outflowHead, 0.002);
+		const double           flow = slab.throughFlow(probeX), steady = reference.discharge(ScreenedSlab::k, 0);
+		const double           perWidth = 1 / (slab.water.density * h * every); // kg per record → m²/s
+		std::printf("  %.2f %.4f %.3e / %.3e (%+.1f%%) %.4f / %.4f  in %.2e out %.2e  %.4f\n", t, table(t), flow, steady, 100 * (flow / steady - 1),
+		            slab.headAt(probeX, probeZ), reference.at(probeX, probeZ), in * perWidth, out * perWidth, slab.farColumnFilling());
 	}
 }
 
