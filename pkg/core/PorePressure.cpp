@@ -1,6 +1,6 @@
 // The pore pressure at the water points of the explicit scheme (doc/theory.md §4, Step 10, eqs.
 // 4.16–4.17c, 2.3): the volume-balance rate, its update, the pressure-mode damping and the free
-// surface. (The semi-implicit pressure lives in PressureProjection.cpp.)
+// surface. (The semi-implicit pressure lives in PressureProjection.hpp and the Pressure*.cpp sources.)
 #include "Stages.hpp"
 
 #include "Stencil.hpp"
