@@ -128,7 +128,7 @@ parser.add_argument("--capillary-surface", action=argparse.BooleanOptionalAction
                          "(MpmTwoPhaseEngine.capillarySurface, theory.md eqs. 8.5e-g); with --no-capillary-surface the semi-implicit "
                          "pile is dry above the table")
 parser.add_argument("--time-step-factor", type=float, metavar="C",
-                    help="the engine's timeStepFactor C, 0 < C ≤ 1: sub-steps of C × its critical step (default the engine's, 0.5)")
+                    help="the engine's timeStepFactor C, 0 < C ≤ 1 (≤ 1/√2 semi-implicit with GIMP, theory.md eq. 8.10b): sub-steps of C × its critical step (default the engine's, 0.5)")
 parser.add_argument("--flip-blend", type=float, metavar="B",
                     help="the engine's flipBlend B, 0 ≤ B ≤ 1: the FLIP share of the points' velocity update, the rest PIC "
                          "(default the engine's, 1: pure FLIP). It changes the pile's answer, not its cost (doc/sandpile.md Cost knobs)")
@@ -289,7 +289,7 @@ engine = MpmTwoPhaseEngine(
     freeSurfaceHoldsSuction=not SEMI_IMPLICIT,  # ... held by capillarity above the phreatic line, a seepage face below it
     capillarySurface=args.capillary_surface,    # the same on the semi-implicit step (theory.md eq. 8.5e)
     removeFreeWater=True,       # the filtering cloth
-    **({} if args.time_step_factor is None else dict(timeStepFactor=args.time_step_factor)),  # the engine refuses C outside (0, 1]
+    **({} if args.time_step_factor is None else dict(timeStepFactor=args.time_step_factor)),  # the engine refuses C outside (0, 1/√2] (semi-implicit, GIMP: theory.md eq. 8.10b)
     **({} if args.flip_blend is None else dict(flipBlend=args.flip_blend)),  # and B outside [0, 1]
     **({} if args.darcy_stabilisation is None else dict(darcyStabilisation=args.darcy_stabilisation)),  # and C outside [0, 10]
     darcySubscales=args.darcy_subscales)  # and refuses C > 0 with the subscales on

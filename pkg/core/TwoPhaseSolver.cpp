@@ -25,6 +25,10 @@ namespace {
 	// the points carry through their outer weights: 1e-9 lost 2e-8 of the gravity impulse of a free
 	// saturated block in 0.05 s with uGIMP (`Momentum.FreeSaturatedBlockGainsTheGravityImpulse`).
 	constexpr double emptyNodeMassFraction = 1e-14;
+	// The largest timeStepFactor the semi-implicit step with GIMP kernels is stable at (theory.md eq. 8.10b):
+	// its skeleton strains with the projected velocities (eq. 8.9), which the re-map does not smooth, so the
+	// node checkerboard of the skeleton's wave is stable only to Δt ω ≤ √2, ω = 2c/h: Δt ≤ h/(√2 c)
+	constexpr double maxProjectedRatesStepFactor = 0.70710678118654752; // 1/√2
 	// More defect corrections per step than this buy nothing the discretisation keeps (theory.md §8.7b).
 	constexpr long maxPressureCorrections = 20;
 	// eq. 8.6b's factor beyond which the stabilisation would outweigh the Darcy flux it stands for by an
@@ -100,6 +104,14 @@ void SolverSettings::validate() const
 {
 	requireClosedRange("flipBlend", flipBlend, 0, 1, "");
 	requireLeftOpenRange("timeStepFactor", timeStepFactor, 0, 1, "");
+	if (scheme == TimeScheme::SemiImplicit && shapeFunction != ShapeFunction::Linear && timeStepFactor > maxProjectedRatesStepFactor) {
+		std::ostringstream msg; // the value as the user wrote it, as throwOutOfRange prints it
+		msg << "timeStepFactor = " << timeStepFactor << " is outside the valid range (0, 0.7071] = (0, 1/√2] of the semi-implicit step with "
+		    << (shapeFunction == ShapeFunction::UGimp ? "uGIMP" : "cpGIMP")
+		    << " shape functions: their skeleton strains with the projected velocities (theory.md eq. 8.9), stable only to Δt ≤ h/(√2 c) (eq. 8.10b); "
+		       "larger factors are stable with shapeFunction = 'linear' or scheme = 'explicit'";
+		throw InvalidParameter(msg.str());
+	}
 	if (!(freeSurfaceThreshold >= 0 && freeSurfaceThreshold < 1)) throwOutOfRange("freeSurfaceThreshold", freeSurfaceThreshold, "", "[0, 1)");
 	if (freeSurfaceHoldsSuction && !(freeSurfaceThreshold > 0))
 		throw InvalidParameter("freeSurfaceHoldsSuction = true needs a free surface: freeSurfaceThreshold = " + std::to_string(freeSurfaceThreshold) +

@@ -20,7 +20,7 @@ struct SolverSettings {
 	ShapeFunction shapeFunction  = ShapeFunction::UGimp;
 	DragScheme    drag           = DragScheme::SemiImplicit;
 	Real          flipBlend      = 1.0;  // α [-], 0 ≤ α ≤ 1 (1 = FLIP, 0 = PIC)
-	Real          timeStepFactor = 0.5;  // C [-], 0 < C ≤ 1, applied to the critical step
+	Real          timeStepFactor = 0.5;  // C [-], 0 < C ≤ 1 (≤ 1/√2 semi-implicit with GIMP, theory.md eq. 8.10b), applied to the critical step
 	Vec3          gravity        = Vec3::Zero(); // b [m s⁻²]
 	bool          cellAveragedVolumetricRate = true; // theory.md eq. 4.17 (pressure and B-bar)
 	bool          pressureModeDamping        = false; // eqs. 4.17b–c (explicit scheme only): pressure modes the grid cannot see decay as a one-cell seepage would

@@ -238,7 +238,7 @@ const AttrTable<MpmTwoPhaseEngine>& MpmTwoPhaseEngine::attributes()
 	static const AttrTable<E> table = [] {
 		AttrTable<E> t {
 		valueAttr<E>("gravity", [](E& e) -> auto& { return e.settings_.gravity; }, "Gravitational acceleration acting on both phases b [m s⁻²]"),
-		valueAttr<E>("timeStepFactor", [](E& e) -> auto& { return e.settings_.timeStepFactor; }, "Safety factor C on the critical time step [-], 0 < C ≤ 1; O.dt is split into sub-steps no larger than C × criticalTimeStep"),
+		valueAttr<E>("timeStepFactor", [](E& e) -> auto& { return e.settings_.timeStepFactor; }, "Safety factor C on the critical time step [-], 0 < C ≤ 1, and C ≤ 1/√2 = 0.7071 for the semi-implicit scheme with uGIMP or cpGIMP (theory.md eq. 8.10b: its skeleton strains with the projected velocities); default 0.5. O.dt is split into sub-steps no larger than C × criticalTimeStep"),
 		valueAttr<E>("maxSubSteps", [](E& e) -> auto& { return e.settings_.maxSubSteps; }, "Most sub-steps one O.dt may be split into [-], ≥ 1: an O.dt that would need more (a mistyped step, e.g. 10 s for a 1e-4 s critical step) is refused before any work, naming O.dt, criticalTimeStep and the sub-steps needed"),
 		valueAttr<E>("flipBlend", [](E& e) -> auto& { return e.settings_.flipBlend; }, "FLIP/PIC blend α of the grid-to-point velocity update [-], 0 ≤ α ≤ 1 (1 = pure FLIP, 0 = PIC); the water in the cell next to an inflow face always moves by PIC (theory.md eq. 4.11d)"),
 		valueAttr<E>("domainMin", [](E& e) -> auto& { return e.domain_.lower; }, "Lower corner of the domain box, whose faces are the walls [m]"),

@@ -226,7 +226,7 @@ def _report(out_dir, dem_result, mpm_result, quick):
 DEM_GRAINS = [200, 300, 500, 1000]
 MPM_VARIANTS = ([("cells", dict(cells=c)) for c in (10, 20, 40, 80)] + [("points per cell", dict(cells=20, points_per_cell=k)) for k in (1, 3)]
                 + [("shape", dict(cells=20, shape_function=f)) for f in ("linear", "cpGIMP")]
-                + [("time-step factor", dict(cells=20, time_step_factor=c)) for c in (0.25, 1.0)])
+                + [("time-step factor", dict(cells=20, time_step_factor=c)) for c in (0.25, 0.7)])  # 0.7: about the largest the semi-implicit uGIMP step takes (1/√2, theory.md eq. 8.10b)
 
 
 def _accuracy(result, oedometric_modulus):

@@ -88,6 +88,20 @@ def test_capillary_surface_belongs_to_the_semi_implicit_scheme():
         w.MpmTwoPhaseEngine(scheme="explicit", capillarySurface=True)
 
 
+def test_semi_implicit_gimp_step_factor_is_bounded_by_its_skeleton_rates():
+    # theory.md eq. 8.10b: with uGIMP or cpGIMP the semi-implicit skeleton strains with the projected
+    # velocities (eq. 8.9) and is stable only to Δt ≤ h/(√2 c), so timeStepFactor above 1/√2 is refused
+    # before any work (a Terzaghi column blew up at 0.9, tests/benchmarks SemiImplicitTimeStep.*); the
+    # linear kernel's re-mapped rates and the explicit scheme keep the whole range (0, 1]
+    w.MpmTwoPhaseEngine(timeStepFactor=0.7)
+    for shape in ("uGIMP", "cpGIMP"):
+        with pytest.raises(ValueError, match=r"timeStepFactor = 0.8 is outside the valid range \(0, 0.7071\] = \(0, 1/√2\] of the semi-implicit step with "
+                                             + shape + r" shape functions: .*\(eq\. 8\.10b\)"):
+            w.MpmTwoPhaseEngine(shapeFunction=shape, timeStepFactor=0.8)
+    w.MpmTwoPhaseEngine(shapeFunction="linear", timeStepFactor=1.0)
+    w.MpmTwoPhaseEngine(scheme="explicit", timeStepFactor=1.0)
+
+
 def test_darcy_subscales_are_the_default_and_set_their_own_weight():
     # theory.md eq. 8.6c: the dynamic subscales are the semi-implicit default and weight the
     # stabilisation themselves, so a quasi-static weight c (eq. 8.6b) at the same time is refused
