@@ -183,8 +183,7 @@ namespace stages {
 	// Relative residual of the plate's response K⁻¹b (eq. 2.9) in the Sherman–Morrison solve.
 	constexpr Real plateResponseTolerance = 1e-10;
 
-	// K x = rhs on the free nodes (with the plate's rank-one term by Sherman–Morrison), CG with a
-	// Jacobi preconditioner from `x` as the first guess; returns false when it does not converge.
+	// (declared, with what it does, in PressureProjectionInternals.hpp)
 	bool solveFreeRows(PressureSystem& system, Eigen::Matrix<Real, Eigen::Dynamic, 1>& rhs, Eigen::Matrix<Real, Eigen::Dynamic, 1>& x, Real tolerance,
 	                   const Eigen::Matrix<Real, Eigen::Dynamic, 1>& coupling, PressureSolveReport& report)
 	{

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 
@@ -106,7 +107,8 @@ void SolverSettings::validate() const
 	requireLeftOpenRange("timeStepFactor", timeStepFactor, 0, 1, "");
 	if (scheme == TimeScheme::SemiImplicit && shapeFunction != ShapeFunction::Linear && timeStepFactor > maxProjectedRatesStepFactor) {
 		std::ostringstream msg; // the value as the user wrote it, as throwOutOfRange prints it
-		msg << "timeStepFactor = " << timeStepFactor << " is outside the valid range (0, 0.7071] = (0, 1/√2] of the semi-implicit step with "
+		msg << "timeStepFactor = " << timeStepFactor << " is outside the valid range (0, " << std::setprecision(4) << maxProjectedRatesStepFactor
+		    << "] = (0, 1/√2] of the semi-implicit step with "
 		    << (shapeFunction == ShapeFunction::UGimp ? "uGIMP" : "cpGIMP")
 		    << " shape functions: their skeleton strains with the projected velocities (theory.md eq. 8.9), stable only to Δt ≤ h/(√2 c) (eq. 8.10b); "
 		       "larger factors are stable with shapeFunction = 'linear' or scheme = 'explicit'";
