@@ -201,7 +201,7 @@ namespace stages {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
 				Real wet = 0;
-				forEachNode<Kernel>(grid, w, [&](std::size_t J, Real N, const Vec3&) {
+				forEachStencilNode<Kernel>(grid, w, [&](std::size_t J, Real N, const Vec3&) {
 					reaches[p] = reaches[p] || slotOf[J] >= 0;
 					if (!water) wet += N * system.skeletonWetting[J];
 				});

@@ -51,24 +51,28 @@ namespace stages {
 			v += xvLane[a] * A + xgLane[a] * B;
 			std::memcpy(slot, &v, sizeof v);
 		};
-		for (int c = 0; c < S; ++c)
-			for (int b = 0; b < S; ++b) {
+		// the pairs of the nodes the point reaches (the others' terms are exact zeros)
+		int lo[3], hi[3];
+		reachedNodes<S>(w, lo, hi);
+		const int xLo = lo[0], xHi = hi[0], yLo = lo[1], yHi = hi[1], zLo = lo[2], zHi = hi[2];
+		for (int c = zLo; c < zHi; ++c)
+			for (int b = yLo; b < yHi; ++b) {
 				Real A[S][S], B[S][S]; // per (cc, bb): the coefficients of Xv and Xg
-				for (int cc = c; cc < S; ++cc)
-					for (int bb = 0; bb < S; ++bb) {
+				for (int cc = c; cc < zHi; ++cc)
+					for (int bb = yLo; bb < yHi; ++bb) {
 						const Real vv = yv[b][bb] * zv[c][cc];
 						A[cc][bb]     = storage * vv + conductance[1] * yg[b][bb] * zv[c][cc] + conductance[2] * yv[b][bb] * zg[c][cc];
 						B[cc][bb]     = conductance[0] * vv;
 					}
-				for (int a = 0; a < S; ++a) {
+				for (int a = xLo; a < xHi; ++a) {
 					// a node where S_J and ∇S_J vanish gets no row (it may have no pressure node)
 					const Real vx = w[0].value[a], vy = w[1].value[b], vz = w[2].value[c];
 					if (vx * vy * vz == 0 && w[0].gradient[a] * vy * vz == 0 && vx * w[1].gradient[b] * vz == 0 && vx * vy * w[2].gradient[c] == 0) continue;
 					Real* r = rows + static_cast<std::size_t>(system.row[grid.index(node[0][a], node[1][b], node[2][c])]) * PressureSystem::rowStride;
-					for (int aa = a; aa < S; ++aa) r[upperSlot(aa - a, 0, 0)] += xv[a][aa] * A[c][b] + xg[a][aa] * B[c][b]; // same y and z: x ≥ 0
-					for (int bb = b + 1; bb < S; ++bb) addRun(r + upperSlot(-a, bb - b, 0), a, A[c][bb], B[c][bb]);
-					for (int cc = c + 1; cc < S; ++cc)
-						for (int bb = 0; bb < S; ++bb) addRun(r + upperSlot(-a, bb - b, cc - c), a, A[cc][bb], B[cc][bb]);
+					for (int aa = a; aa < xHi; ++aa) r[upperSlot(aa - a, 0, 0)] += xv[a][aa] * A[c][b] + xg[a][aa] * B[c][b]; // same y and z: x ≥ 0
+					for (int bb = b + 1; bb < yHi; ++bb) addRun(r + upperSlot(-a, bb - b, 0), a, A[c][bb], B[c][bb]);
+					for (int cc = c + 1; cc < zHi; ++cc)
+						for (int bb = yLo; bb < yHi; ++bb) addRun(r + upperSlot(-a, bb - b, cc - c), a, A[cc][bb], B[cc][bb]);
 				}
 			}
 	}
@@ -115,24 +119,34 @@ namespace stages {
 			Vec3                     D[U * U * U];
 			bool                     touched[U * U * U] = {};
 			for (Vec3& v : D) v.setZero();
-			Real                     W = 0;
+			Real W = 0;
+			int  boxLo[3] = { U, U, U }, boxHi[3] = {}; // the part [boxLo, boxHi) of the box that the points reach
 			for (std::size_t q = system.cellPointStart[occupied]; q < system.cellPointStart[occupied + 1]; ++q) {
 				const std::size_t p = system.cellPoints[q];
 				Weights1D         w[3];
 				weightsAt<Kernel>(grid, P, p, w);
-				int  shift[3]; // box index of the stencil's first node
+				int  shift[3], corner[3]; // box index of the stencil's first node; the cell's lower node in the stencil
 				bool inStencil = true;
 				for (int d = 0; d < 3; ++d) {
-					const int corner = cell[d] - w[d].first; // the cell's lower node in the stencil
-					inStencil        = inStencil && corner >= 0 && corner + 1 < S;
-					shift[d]         = inner - corner;
+					corner[d] = cell[d] - w[d].first;
+					inStencil = inStencil && corner[d] >= 0 && corner[d] + 1 < S;
+					shift[d]  = inner - corner[d];
 				}
 				if (!inStencil) continue; // a point off the grid's cells: no S (eq. 8.6b's G is undefined there)
 				const Real wp = weight[p];
 				W += wp;
-				for (int c = 0; c < S; ++c)
-					for (int b = 0; b < S; ++b)
-						for (int a = 0; a < S; ++a) {
+				// the stencil's nodes the point reaches (D gains nothing at the others) and the cell's own,
+				// whose pairs carry W H_J·H_K
+				int lo[3], hi[3];
+				reachedNodes<Kernel::stencil>(w, lo, hi);
+				for (int d = 0; d < 3; ++d)
+					boxLo[d] = std::min({ boxLo[d], lo[d] + shift[d], corner[d] + shift[d] }), boxHi[d] = std::max({ boxHi[d], hi[d] + shift[d], corner[d] + shift[d] + 2 });
+				for (int k = 0; k < 2; ++k)
+					for (int j = 0; j < 2; ++j)
+						for (int i = 0; i < 2; ++i) touched[boxIndex(corner[0] + shift[0] + i, corner[1] + shift[1] + j, corner[2] + shift[2] + k)] = true;
+				for (int c = lo[2]; c < hi[2]; ++c)
+					for (int b = lo[1]; b < hi[1]; ++b)
+						for (int a = lo[0]; a < hi[0]; ++a) {
 							const int l = boxIndex(a + shift[0], b + shift[1], c + shift[2]);
 							const Vec3 dN(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
 							              w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
@@ -142,9 +156,9 @@ namespace stages {
 			}
 			if (!(W > 0)) return;
 			int row[U * U * U];
-			for (int c = 0; c < U; ++c)
-				for (int b = 0; b < U; ++b)
-					for (int a = 0; a < U; ++a) {
+			for (int c = boxLo[2]; c < boxHi[2]; ++c)
+				for (int b = boxLo[1]; b < boxHi[1]; ++b)
+					for (int a = boxLo[0]; a < boxHi[0]; ++a) {
 						const int l = boxIndex(a, b, c);
 						row[l]      = touched[l] ? system.row[grid.index(grid.wrap(0, cell[0] - inner + a), grid.wrap(1, cell[1] - inner + b), grid.wrap(2, cell[2] - inner + c))] : -1;
 					}
@@ -156,9 +170,9 @@ namespace stages {
 						if (rowK < 0) continue;
 						const Vec3  HK = centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
 						const Vec3& DK = D[lK];
-						for (int c = 0; c < U; ++c)
-							for (int b = 0; b < U; ++b)
-								for (int a = 0; a < U; ++a) {
+						for (int c = boxLo[2]; c < boxHi[2]; ++c)
+							for (int b = boxLo[1]; b < boxHi[1]; ++b)
+								for (int a = boxLo[0]; a < boxHi[0]; ++a) {
 									const int lJ = boxIndex(a, b, c), rowJ = row[lJ];
 									if (rowJ < 0) continue;
 									const int  iJ = a - inner, jJ = b - inner, kJ = c - inner;
@@ -266,11 +280,16 @@ namespace stages {
 				// predicted skeleton (mixture) velocity and the relative velocity w = vw − vs
 				Real n = 0, divMixture = 0, darcy = 0;
 				Vec3 lambda = Vec3::Zero(), relative = Vec3::Zero();
-				Real N[S][S][S];
+				Real N[S][S][S] = {};
 				Vec3 dN[S][S][S];
-				for (int c = 0; c < S; ++c)
-					for (int b = 0; b < S; ++b)
-						for (int a = 0; a < S; ++a) {
+				for (auto& plane : dN)
+					for (auto& line : plane)
+						for (Vec3& g : line) g.setZero();
+				int lo[3], hi[3]; // the stencil's nodes the point reaches: the others' S and ∇S are zero
+				reachedNodes<S>(w, lo, hi);
+				for (int c = lo[2]; c < hi[2]; ++c)
+					for (int b = lo[1]; b < hi[1]; ++b)
+						for (int a = lo[0]; a < hi[0]; ++a) {
 							N[c][b][a]  = w[0].value[a] * w[1].value[b] * w[2].value[c];
 							dN[c][b][a] = Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
 							                   w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
@@ -299,9 +318,9 @@ namespace stages {
 				}
 				if (darcy > 0) conductance += Vec3::Constant(V * darcy);
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n
-				for (int c = 0; c < S; ++c)
-					for (int b = 0; b < S; ++b)
-						for (int a = 0; a < S; ++a) {
+				for (int c = lo[2]; c < hi[2]; ++c)
+					for (int b = lo[1]; b < hi[1]; ++b)
+						for (int a = lo[0]; a < hi[0]; ++a) {
 							if (N[c][b][a] == 0 && dN[c][b][a].isZero()) continue;
 							rows[static_cast<std::size_t>(system.row[grid.index(node[0][a], node[1][b], node[2][c])]) * PressureSystem::rowStride +
 							     PressureSystem::rhsSlot] += N[c][b][a] * (stored - V * divergence) + V * relativeFlux.dot(dN[c][b][a]);
@@ -315,9 +334,12 @@ namespace stages {
 					int  corner[3];
 					if (fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner)) {
 						const Vec3 kept = V * memory * P.subscaleFlux[p];
-						for (int c = 0; c < S; ++c)
-							for (int b = 0; b < S; ++b)
-								for (int a = 0; a < S; ++a) {
+						// G is ∇S_J off the cell's nodes: zero at the nodes the point does not reach
+						int gLo[3], gHi[3];
+						fluctuationNodes<S>(w, corner, gLo, gHi);
+						for (int c = gLo[2]; c < gHi[2]; ++c)
+							for (int b = gLo[1]; b < gHi[1]; ++b)
+								for (int a = gLo[0]; a < gHi[0]; ++a) {
 									const int r = system.row[grid.index(node[0][a], node[1][b], node[2][c])];
 									if (r >= 0) rows[static_cast<std::size_t>(r) * PressureSystem::rowStride + PressureSystem::rhsSlot] += G[c][b][a].dot(kept);
 								}

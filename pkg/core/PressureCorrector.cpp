@@ -42,10 +42,12 @@ namespace stages {
 						P.subscaleFlux[p].setZero();
 						continue;
 					}
+					int lo[3], hi[3];
+					fluctuationNodes<S>(w, corner, lo, hi);
 					Vec3 g = Vec3::Zero();
-					for (int c = 0; c < S; ++c)
-						for (int b = 0; b < S; ++b)
-							for (int a = 0; a < S; ++a) g += pressure[grid.index(node[0][a], node[1][b], node[2][c])] * G[c][b][a];
+					for (int c = lo[2]; c < hi[2]; ++c)
+						for (int b = lo[1]; b < hi[1]; ++b)
+							for (int a = lo[0]; a < hi[0]; ++a) g += pressure[grid.index(node[0][a], node[1][b], node[2][c])] * G[c][b][a];
 					P.subscaleFlux[p] = sw.memory * P.subscaleFlux[p] - sw.instant * g;
 				}
 			}

@@ -185,7 +185,7 @@ namespace stages {
 			for (std::size_t p = 0; p < count; ++p) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
-				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3&) {
+				forEachStencilNode<Kernel>(grid, w, [&](std::size_t I, Real, const Vec3&) {
 #pragma omp atomic write
 					row[I] = 0;
 				});

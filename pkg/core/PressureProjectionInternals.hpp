@@ -57,6 +57,14 @@ namespace projection {
 		return true;
 	}
 
+	// The nodes [lo, hi) per axis where a point's G_J (eq. 8.6b) can differ from zero: those it reaches
+	// (reachedNodes) and its cell's own (cellCorner from cellCornerInStencil).
+	template <int S> inline void fluctuationNodes(const Weights1D (&w)[3], const int (&cellCorner)[3], int (&lo)[3], int (&hi)[3])
+	{
+		reachedNodes<S>(w, lo, hi);
+		for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], cellCorner[d]), hi[d] = std::max(hi[d], cellCorner[d] + 2);
+	}
+
 	// At one point of stencil `node`: the weight gradients ∇S_J, and the nodes' c κ/μw (`darcy`) and
 	// mobility λ interpolated (λ only where eq. 8.6c needs it)
 	template <int S>
@@ -65,9 +73,14 @@ namespace projection {
 	{
 		darcy  = 0;
 		lambda = Vec3::Zero();
-		for (int c = 0; c < S; ++c)
-			for (int b = 0; b < S; ++b)
-				for (int a = 0; a < S; ++a) {
+		int lo[3], hi[3]; // the nodes the point reaches: S and ∇S are zero at the others
+		reachedNodes<S>(w, lo, hi);
+		for (auto& plane : dN)
+			for (auto& line : plane)
+				for (Vec3& g : line) g.setZero();
+		for (int c = lo[2]; c < hi[2]; ++c)
+			for (int b = lo[1]; b < hi[1]; ++b)
+				for (int a = lo[0]; a < hi[0]; ++a) {
 					dN[c][b][a] = Vec3(w[0].gradient[a] * w[1].value[b] * w[2].value[c], w[0].value[a] * w[1].gradient[b] * w[2].value[c],
 					                   w[0].value[a] * w[1].value[b] * w[2].gradient[c]);
 					const std::size_t I  = grid.index(node[0][a], node[1][b], node[2][c]);
@@ -105,13 +118,15 @@ namespace projection {
 		if (system.dynamicSubscales) darcy = subscaleWeights(darcy, lambda, system.subscaleStep).instant; // eq. 8.6c: S's weight of this step
 		int corner[3];
 		if (!(darcy > 0) || !fluctuationGradients<S>(grid, position, w, dN, G, corner)) return;
+		int lo[3], hi[3];
+		fluctuationNodes<S>(w, corner, lo, hi);
 		Vec3 g = Vec3::Zero();
-		for (int c = 0; c < S; ++c)
-			for (int b = 0; b < S; ++b)
-				for (int a = 0; a < S; ++a) g += q[grid.index(node[0][a], node[1][b], node[2][c])] * G[c][b][a];
-		for (int c = 0; c < S; ++c)
-			for (int b = 0; b < S; ++b)
-				for (int a = 0; a < S; ++a) {
+		for (int c = lo[2]; c < hi[2]; ++c)
+			for (int b = lo[1]; b < hi[1]; ++b)
+				for (int a = lo[0]; a < hi[0]; ++a) g += q[grid.index(node[0][a], node[1][b], node[2][c])] * G[c][b][a];
+		for (int c = lo[2]; c < hi[2]; ++c)
+			for (int b = lo[1]; b < hi[1]; ++b)
+				for (int a = lo[0]; a < hi[0]; ++a) {
 					const int r = system.row[grid.index(node[0][a], node[1][b], node[2][c])];
 					if (r >= 0) rows[r] += V * darcy * G[c][b][a].dot(g);
 				}

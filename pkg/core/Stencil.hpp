@@ -50,8 +50,48 @@ namespace mpm::detail {
 			for (int a = 0; a < S; ++a) node[d][a] = g.wrap(d, w[d].first + a);
 	}
 
-	// Call f(node, S, ∇S) for every node of the point's stencil (tensor product).
+	// The nodes [lo, hi) of a point's stencil along each axis where its weight or its gradient is not
+	// zero: a GIMP point whose domain lies within one cell along an axis reaches two of its three
+	// nodes there (every point of the initial lattice at two points per cell; half of them once they
+	// have moved). A sum of products with S_I or ∇S_I over the reached nodes is the stencil's sum bit
+	// for bit: the nodes left out add exact zeros.
+	template <int S> inline void reachedNodes(const Weights1D (&w)[3], int (&lo)[3], int (&hi)[3])
+	{
+		for (int d = 0; d < 3; ++d) {
+			lo[d] = 0, hi[d] = S;
+			if constexpr (S == 3) {
+				if (w[d].value[0] == 0 && w[d].gradient[0] == 0) lo[d] = 1;
+				if (w[d].value[2] == 0 && w[d].gradient[2] == 0) hi[d] = 2;
+			}
+		}
+	}
+
+	// Call f(node, S, ∇S) for every node the point reaches (tensor product; reachedNodes): the sums
+	// that the stages gather or scatter over a point's stencil.
 	template <class Kernel, class F> inline void forEachNode(const GridGeometry& g, const Weights1D (&w)[3], F&& f)
+	{
+		constexpr int S = Kernel::stencil;
+		int           node[3][S], lo[3], hi[3];
+		stencilNodes(g, w, node);
+		reachedNodes<S>(w, lo, hi);
+		for (int c = lo[2]; c < hi[2]; ++c)
+			for (int b = lo[1]; b < hi[1]; ++b) {
+				const Real        vyz  = w[1].value[b] * w[2].value[c];
+				const Real        gyz  = w[1].gradient[b] * w[2].value[c];
+				const Real        vygz = w[1].value[b] * w[2].gradient[c];
+				const std::size_t row  = g.index(0, node[1][b], node[2][c]);
+				for (int a = lo[0]; a < hi[0]; ++a) {
+					const Real N = w[0].value[a] * vyz;
+					if (N == 0 && w[0].gradient[a] == 0) continue;
+					f(row + node[0][a], N, Vec3(w[0].gradient[a] * vyz, w[0].value[a] * gyz, w[0].value[a] * vygz));
+				}
+			}
+	}
+
+	// The same over the whole stencil but for the nodes with S = 0 and ∂S/∂x = 0 (the visit that decides
+	// which nodes carry a pressure row, and which points touch the capillary surface's rows; forEachNode's
+	// reached nodes are a subset, whose sums are the same).
+	template <class Kernel, class F> inline void forEachStencilNode(const GridGeometry& g, const Weights1D (&w)[3], F&& f)
 	{
 		constexpr int S = Kernel::stencil;
 		int           node[3][S];
