@@ -331,12 +331,9 @@ namespace stages {
 				// zero: a clay's flux of 1e-13 m/s counts too)
 				if (memory > 0 && P.subscaleFlux[p] != Vec3::Zero()) {
 					Vec3 G[S][S][S];
-					int  corner[3];
-					if (fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner)) {
+					int  corner[3], gLo[3], gHi[3];
+					if (fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner, gLo, gHi)) {
 						const Vec3 kept = V * memory * P.subscaleFlux[p];
-						// G is ∇S_J off the cell's nodes: zero at the nodes the point does not reach
-						int gLo[3], gHi[3];
-						fluctuationNodes<S>(w, corner, gLo, gHi);
 						for (int c = gLo[2]; c < gHi[2]; ++c)
 							for (int b = gLo[1]; b < gHi[1]; ++b)
 								for (int a = gLo[0]; a < gHi[0]; ++a) {

@@ -37,13 +37,11 @@ namespace stages {
 					Vec3 lambda, dN[S][S][S], G[S][S][S];
 					darcyAtPoint<S>(grid, w, node, system, true, dN, darcy, lambda);
 					const SubscaleWeights sw = subscaleWeights(darcy, lambda, system.subscaleStep);
-					int corner[3];
-					if (!(sw.instant > 0) || !fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner)) {
+					int corner[3], lo[3], hi[3];
+					if (!(sw.instant > 0) || !fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner, lo, hi)) {
 						P.subscaleFlux[p].setZero();
 						continue;
 					}
-					int lo[3], hi[3];
-					fluctuationNodes<S>(w, corner, lo, hi);
 					Vec3 g = Vec3::Zero();
 					for (int c = lo[2]; c < hi[2]; ++c)
 						for (int b = lo[1]; b < hi[1]; ++b)

@@ -36,33 +36,35 @@ namespace projection {
 		return true;
 	}
 
-	// The local projection stabilisation of eq. 8.6b at one point: G_J = ∇S_J(x_p) − ∇N_J(x_c), the
-	// gradient of node J's weight at the point less that of its trilinear hat at the centre x_c of the
-	// point's cell (zero off the cell's eight nodes), so that Σ_J G_J p_J is the part of the point's
-	// pressure gradient that departs from the cell's mean one: zero for any linear nodal field. Returns
-	// false where the cell's nodes are not all in the stencil (a point off the grid's cells).
-	template <int S>
-	inline bool fluctuationGradients(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const Vec3 (&dN)[S][S][S], Vec3 (&G)[S][S][S],
-	                                 int (&cellCorner)[3])
-	{
-		if (!cellCornerInStencil<S>(grid, position, w, cellCorner)) return false;
-		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
-		for (int c = 0; c < S; ++c)
-			for (int b = 0; b < S; ++b)
-				for (int a = 0; a < S; ++a) {
-					G[c][b][a]   = dN[c][b][a];
-					const int i = a - cellCorner[0], j = b - cellCorner[1], k = c - cellCorner[2];
-					if (i >= 0 && i <= 1 && j >= 0 && j <= 1 && k >= 0 && k <= 1) G[c][b][a] -= centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
-				}
-		return true;
-	}
-
 	// The nodes [lo, hi) per axis where a point's G_J (eq. 8.6b) can differ from zero: those it reaches
 	// (reachedNodes) and its cell's own (cellCorner from cellCornerInStencil).
 	template <int S> inline void fluctuationNodes(const Weights1D (&w)[3], const int (&cellCorner)[3], int (&lo)[3], int (&hi)[3])
 	{
 		reachedNodes<S>(w, lo, hi);
 		for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], cellCorner[d]), hi[d] = std::max(hi[d], cellCorner[d] + 2);
+	}
+
+	// The local projection stabilisation of eq. 8.6b at one point: G_J = ∇S_J(x_p) − ∇N_J(x_c), the
+	// gradient of node J's weight at the point less that of its trilinear hat at the centre x_c of the
+	// point's cell (zero off the cell's eight nodes), so that Σ_J G_J p_J is the part of the point's
+	// pressure gradient that departs from the cell's mean one: zero for any linear nodal field. G is
+	// written on the nodes [lo, hi) of fluctuationNodes only (it is zero at the others). Returns false
+	// where the cell's nodes are not all in the stencil (a point off the grid's cells).
+	template <int S>
+	inline bool fluctuationGradients(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const Vec3 (&dN)[S][S][S], Vec3 (&G)[S][S][S],
+	                                 int (&cellCorner)[3], int (&lo)[3], int (&hi)[3])
+	{
+		if (!cellCornerInStencil<S>(grid, position, w, cellCorner)) return false;
+		fluctuationNodes<S>(w, cellCorner, lo, hi);
+		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
+		for (int c = lo[2]; c < hi[2]; ++c)
+			for (int b = lo[1]; b < hi[1]; ++b)
+				for (int a = lo[0]; a < hi[0]; ++a) {
+					G[c][b][a]   = dN[c][b][a];
+					const int i = a - cellCorner[0], j = b - cellCorner[1], k = c - cellCorner[2];
+					if (i >= 0 && i <= 1 && j >= 0 && j <= 1 && k >= 0 && k <= 1) G[c][b][a] -= centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
+				}
+		return true;
 	}
 
 	// At one point of stencil `node`: the weight gradients ∇S_J, and the nodes' c κ/μw (`darcy`) and
@@ -116,10 +118,8 @@ namespace projection {
 		Vec3 lambda;
 		darcyAtPoint<S>(grid, w, node, system, system.dynamicSubscales, dN, darcy, lambda);
 		if (system.dynamicSubscales) darcy = subscaleWeights(darcy, lambda, system.subscaleStep).instant; // eq. 8.6c: S's weight of this step
-		int corner[3];
-		if (!(darcy > 0) || !fluctuationGradients<S>(grid, position, w, dN, G, corner)) return;
-		int lo[3], hi[3];
-		fluctuationNodes<S>(w, corner, lo, hi);
+		int corner[3], lo[3], hi[3];
+		if (!(darcy > 0) || !fluctuationGradients<S>(grid, position, w, dN, G, corner, lo, hi)) return;
 		Vec3 g = Vec3::Zero();
 		for (int c = lo[2]; c < hi[2]; ++c)
 			for (int b = lo[1]; b < hi[1]; ++b)
