@@ -23,12 +23,13 @@ namespace stages {
 	{
 		Weights1D w[3];
 		weightsAt<Kernel>(grid, position, halfLength, w);
-		int node[3][Kernel::stencil];
+		int node[3][Kernel::stencil], lo[3], hi[3];
 		stencilNodes(grid, w, node);
+		reachedNodes<Kernel::stencil>(w, lo, hi); // S = 0 at the others
 		Real filling = 0;
-		for (int c = 0; c < Kernel::stencil; ++c)
-			for (int b = 0; b < Kernel::stencil; ++b)
-				for (int a = 0; a < Kernel::stencil; ++a) {
+		for (int c = lo[2]; c < hi[2]; ++c)
+			for (int b = lo[1]; b < hi[1]; ++b)
+				for (int a = lo[0]; a < hi[0]; ++a) {
 					const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
 					if (N <= 0) continue;
 					const int i = node[0][a], j = node[1][b], k = node[2][c];
@@ -122,13 +123,14 @@ namespace stages {
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, P, p, w);
-			int node[3][Kernel::stencil];
+			int node[3][Kernel::stencil], lo[3], hi[3];
 			stencilNodes(grid, w, node);
+			reachedNodes<Kernel::stencil>(w, lo, hi); // S = 0 at the others, which the loop skips
 			bool inside = true;
 			Real smoothed = 0;
-			for (int c = 0; c < Kernel::stencil && inside; ++c)
-				for (int b = 0; b < Kernel::stencil && inside; ++b)
-					for (int a = 0; a < Kernel::stencil && inside; ++a) {
+			for (int c = lo[2]; c < hi[2] && inside; ++c)
+				for (int b = lo[1]; b < hi[1] && inside; ++b)
+					for (int a = lo[0]; a < hi[0] && inside; ++a) {
 						const Real N = w[0].value[a] * w[1].value[b] * w[2].value[c];
 						if (N <= 0) continue;
 						const int idx[3] = { node[0][a], node[1][b], node[2][c] };
