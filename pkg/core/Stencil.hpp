@@ -52,9 +52,9 @@ namespace mpm::detail {
 
 	// The nodes [lo, hi) of a point's stencil along each axis where its weight or its gradient is not
 	// zero: a GIMP point whose domain lies within one cell along an axis reaches two of its three
-	// nodes there (every point of the initial lattice at two points per cell; half of them once they
-	// have moved). A sum of products with S_I or ∇S_I over the reached nodes is the stencil's sum bit
-	// for bit: the nodes left out add exact zeros.
+	// nodes there (most points of a lattice at two points per cell: the rest sit a round-off inside the
+	// end node's support; about half once they have moved). A sum of products with S_I or ∇S_I over the
+	// reached nodes is the stencil's sum bit for bit: the nodes left out add exact zeros.
 	template <int S> inline void reachedNodes(const Weights1D (&w)[3], int (&lo)[3], int (&hi)[3])
 	{
 		for (int d = 0; d < 3; ++d) {
@@ -88,9 +88,10 @@ namespace mpm::detail {
 			}
 	}
 
-	// The same over the whole stencil but for the nodes with S = 0 and ∂S/∂x = 0 (the visit that decides
-	// which nodes carry a pressure row, and which points touch the capillary surface's rows; forEachNode's
-	// reached nodes are a subset, whose sums are the same).
+	// The same over the whole stencil but for the nodes with S = 0 and ∂S/∂x = 0: the visit that decides
+	// which nodes carry a pressure row, and which points touch the capillary surface's rows (forEachNode's
+	// reached nodes are a subset, whose sums are the same). Its own loop: one body for both, with the
+	// bounds chosen at compile time, measured 1–2% more instructions per step.
 	template <class Kernel, class F> inline void forEachStencilNode(const GridGeometry& g, const Weights1D (&w)[3], F&& f)
 	{
 		constexpr int S = Kernel::stencil;
