@@ -48,7 +48,8 @@ namespace projection {
 	// gradient of node J's weight at the point less that of its trilinear hat at the centre x_c of the
 	// point's cell (zero off the cell's eight nodes), so that Σ_J G_J p_J is the part of the point's
 	// pressure gradient that departs from the cell's mean one: zero for any linear nodal field. G is
-	// written on the nodes [lo, hi) of fluctuationNodes only (it is zero at the others). Returns false
+	// written on the nodes [lo, hi) of fluctuationNodes only: it is zero at the others, which it leaves
+	// unwritten (callers loop over [lo, hi)). Returns false
 	// where the cell's nodes are not all in the stencil (a point off the grid's cells).
 	template <int S>
 	inline bool fluctuationGradients(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const Vec3 (&dN)[S][S][S], Vec3 (&G)[S][S][S],
