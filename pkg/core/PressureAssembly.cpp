@@ -28,8 +28,8 @@ namespace stages {
 	template <int S> using PairLane = std::conditional_t<pairLanes<S> == 4, PairLane4, PairLane2>;
 
 	template <int S>
-	inline void addPairTerms(const GridGeometry& grid, const Weights1D (&w)[3], const int (&node)[3][S], Real storage, const Vec3& conductance,
-	                         const PressureSystem& system, Real* rows)
+	inline void addPairTerms(const GridGeometry& grid, const Weights1D (&w)[3], const int (&node)[3][S], const int (&lo)[3], const int (&hi)[3], Real storage,
+	                         const Vec3& conductance, const PressureSystem& system, Real* rows)
 	{
 		static_assert(pairLanes<S> >= S && sizeof(PairLane<S>) == pairLanes<S> * sizeof(Real), "a run of S slots fits in one lane vector");
 		using Lane = PairLane<S>;
@@ -51,9 +51,7 @@ namespace stages {
 			v += xvLane[a] * A + xgLane[a] * B;
 			std::memcpy(slot, &v, sizeof v);
 		};
-		// the pairs of the nodes the point reaches (the others' terms are exact zeros)
-		int lo[3], hi[3];
-		reachedNodes<S>(w, lo, hi);
+		// the pairs of the nodes the point reaches, [lo, hi) of reachedNodes (the others' terms are exact zeros)
 		const int xLo = lo[0], xHi = hi[0], yLo = lo[1], yHi = hi[1], zLo = lo[2], zHi = hi[2];
 		for (int c = zLo; c < zHi; ++c)
 			for (int b = yLo; b < yHi; ++b) {
@@ -280,12 +278,12 @@ namespace stages {
 				// predicted skeleton (mixture) velocity and the relative velocity w = vw − vs
 				Real n = 0, divMixture = 0, darcy = 0;
 				Vec3 lambda = Vec3::Zero(), relative = Vec3::Zero();
-				Real N[S][S][S] = {};
+				Real N[S][S][S]; // on the nodes the point reaches, [lo, hi) (the loops below read no other)
 				Vec3 dN[S][S][S];
-				for (auto& plane : dN)
+				for (auto& plane : dN) // zero off them: fluctuationGradients reads the cell's nodes too
 					for (auto& line : plane)
 						for (Vec3& g : line) g.setZero();
-				int lo[3], hi[3]; // the stencil's nodes the point reaches: the others' S and ∇S are zero
+				int lo[3], hi[3];
 				reachedNodes<S>(w, lo, hi);
 				for (int c = lo[2]; c < hi[2]; ++c)
 					for (int b = lo[1]; b < hi[1]; ++b)
@@ -325,7 +323,7 @@ namespace stages {
 							rows[static_cast<std::size_t>(system.row[grid.index(node[0][a], node[1][b], node[2][c])]) * PressureSystem::rowStride +
 							     PressureSystem::rhsSlot] += N[c][b][a] * (stored - V * divergence) + V * relativeFlux.dot(dN[c][b][a]);
 						}
-				addPairTerms<S>(grid, w, node, storage, conductance, system, rows);
+				addPairTerms<S>(grid, w, node, lo, hi, storage, conductance, system, rows);
 				system.fluctuationWeight[p] = darcy > 0 ? V * darcy : 0; // eq. 8.6b/c's pairs: per cell, after this pass
 				// + V G_J·(memory q′^n): the divergence of the subscale flux the point keeps (tested for an exact
 				// zero: a clay's flux of 1e-13 m/s counts too)

@@ -36,40 +36,35 @@ namespace projection {
 		return true;
 	}
 
-	// The nodes [lo, hi) per axis where a point's G_J (eq. 8.6b) can differ from zero: those it reaches
-	// (reachedNodes) and its cell's own (cellCorner from cellCornerInStencil).
-	template <int S> inline void fluctuationNodes(const Weights1D (&w)[3], const int (&cellCorner)[3], int (&lo)[3], int (&hi)[3])
-	{
-		reachedNodes<S>(w, lo, hi);
-		for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], cellCorner[d]), hi[d] = std::max(hi[d], cellCorner[d] + 2);
-	}
-
 	// The local projection stabilisation of eq. 8.6b at one point: G_J = ∇S_J(x_p) − ∇N_J(x_c), the
 	// gradient of node J's weight at the point less that of its trilinear hat at the centre x_c of the
 	// point's cell (zero off the cell's eight nodes), so that Σ_J G_J p_J is the part of the point's
-	// pressure gradient that departs from the cell's mean one: zero for any linear nodal field. G is
-	// written on the nodes [lo, hi) of fluctuationNodes only: it is zero at the others, which it leaves
-	// unwritten (callers loop over [lo, hi)). Returns false
-	// where the cell's nodes are not all in the stencil (a point off the grid's cells).
+	// pressure gradient that departs from the cell's mean one: zero for any linear nodal field. dN is
+	// read on the nodes [lo, hi) where G can differ from zero, those the point reaches (reachedNodes) and
+	// its cell's own (dN zero there where not reached, as darcyAtPoint leaves it); G is written there and
+	// left unwritten elsewhere (callers loop over [lo, hi)). Returns false where the cell's nodes are not
+	// all in the stencil (a point off the grid's cells).
 	template <int S>
 	inline bool fluctuationGradients(const GridGeometry& grid, const Vec3& position, const Weights1D (&w)[3], const Vec3 (&dN)[S][S][S], Vec3 (&G)[S][S][S],
 	                                 int (&cellCorner)[3], int (&lo)[3], int (&hi)[3])
 	{
 		if (!cellCornerInStencil<S>(grid, position, w, cellCorner)) return false;
-		fluctuationNodes<S>(w, cellCorner, lo, hi);
+		int reachedLo[3], reachedHi[3];
+		reachedNodes<S>(w, reachedLo, reachedHi);
+		for (int d = 0; d < 3; ++d) lo[d] = std::min(reachedLo[d], cellCorner[d]), hi[d] = std::max(reachedHi[d], cellCorner[d] + 2);
 		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
 		for (int c = lo[2]; c < hi[2]; ++c)
 			for (int b = lo[1]; b < hi[1]; ++b)
 				for (int a = lo[0]; a < hi[0]; ++a) {
-					G[c][b][a]   = dN[c][b][a];
+					G[c][b][a]  = dN[c][b][a];
 					const int i = a - cellCorner[0], j = b - cellCorner[1], k = c - cellCorner[2];
 					if (i >= 0 && i <= 1 && j >= 0 && j <= 1 && k >= 0 && k <= 1) G[c][b][a] -= centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
 				}
 		return true;
 	}
 
-	// At one point of stencil `node`: the weight gradients ∇S_J, and the nodes' c κ/μw (`darcy`) and
-	// mobility λ interpolated (λ only where eq. 8.6c needs it)
+	// At one point of stencil `node`: the weight gradients ∇S_J (zero off the nodes it reaches), and the
+	// nodes' c κ/μw (`darcy`) and mobility λ interpolated (λ only where eq. 8.6c needs it)
 	template <int S>
 	inline void darcyAtPoint(const GridGeometry& grid, const Weights1D (&w)[3], const int (&node)[3][S], const PressureSystem& system, bool withMobility,
 	                         Vec3 (&dN)[S][S][S], Real& darcy, Vec3& lambda)

@@ -29,7 +29,7 @@ namespace {
 	// The largest timeStepFactor the semi-implicit step with GIMP kernels is stable at (theory.md eq. 8.10b):
 	// its skeleton strains with the projected velocities (eq. 8.9), which the re-map does not smooth, so the
 	// node checkerboard of the skeleton's wave is stable only to Δt ω ≤ √2, ω = 2c/h: Δt ≤ h/(√2 c)
-	constexpr double maxProjectedRatesStepFactor = 0.70710678118654752; // 1/√2
+	constexpr double maxProjectedRatesStepFactor = M_SQRT1_2; // 1/√2
 	// More defect corrections per step than this buy nothing the discretisation keeps (theory.md §8.7b).
 	constexpr long maxPressureCorrections = 20;
 	// eq. 8.6b's factor beyond which the stabilisation would outweigh the Darcy flux it stands for by an
