@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 namespace mpm {
 namespace stages {
@@ -307,7 +308,11 @@ namespace stages {
 						// points: Σ_IJ += V (1 − n) S_J ∇S_I
 						for (int b = 0; b < m; ++b) {
 							const Real sN = (1 - n) * N[b];
-							for (int d = 0; d < 3; ++d) c[place[b]].surface[d] += sN * Da[d];
+							for (int d = 0; d < 3; ++d) {
+								const Real term = sN * Da[d];
+								c[place[b]].surface[d] += term;
+								c[place[b]].grains[d] += term;
+							}
 						}
 						continue;
 					}
@@ -339,6 +344,7 @@ namespace stages {
 					coupling[c][o].surface += more[c][o].surface;
 					coupling[c][o].solid += more[c][o].solid;
 					coupling[c][o].water += more[c][o].water;
+					coupling[c][o].grains += more[c][o].grains;
 				}
 			}
 		}
@@ -359,7 +365,13 @@ namespace stages {
 			// the reached rows in offset order, which is the rows' order (rows are numbered in grid-node
 			// order and the box around I does not wrap), so a pair's first node always has the smaller row
 			int rowOf[125], code[125], m = 0;
-			alignas(64) Real u[9][125];
+			// θ_I = min(1, V_I/V^w_I), the part of the water-sampled support the skeleton covers: eq. 8.1 puts
+			// the water points' reaction θ on the grains and 1 − θ on the water, and F_I must do the same
+			// (eq. 8.5j). θ = 1 (the grains cover the water's support) keeps the three components (Σ, g^s, g^w);
+			// below it a fourth, Σ's solid points' part P, is needed to tell the two forces apart
+			const Real theta = system.skeletonShare[I];
+			const int  parts = theta < 1 ? 4 : 3;
+			alignas(64) Real u[12][125];
 			alignas(64) Real pairValue[125];
 			for (int o = 0; o < 125; ++o) {
 				const int a = o % 5 - 2, b = (o / 5) % 5 - 2, cc = o / 25 - 2;
@@ -371,39 +383,63 @@ namespace stages {
 				const bool      counts  = J.surface.norm() > negligible;
 				rowOf[m]                = row;
 				code[m]                 = ((o / 25) * width[1] + (o / 5) % 5) * width[0] + o % 5; // the offset + (2, 2, 2) in the radix W
-				for (int d = 0; d < 3; ++d) u[3 * d][m] = counts ? J.surface[d] : 0, u[3 * d + 1][m] = J.solid[d], u[3 * d + 2][m] = J.water[d];
+				for (int d = 0; d < 3; ++d) {
+					Real* ud = &u[parts * d][0];
+					ud[m] = counts ? J.surface[d] : 0, ud[125 + m] = J.solid[d], ud[250 + m] = J.water[d];
+					if (parts == 4) ud[375 + m] = counts ? J.grains[d] : 0;
+				}
 				++m;
 			}
 			const Vec3 cross     = 0.5 * (sw[I] + ws[I]); // R's off-diagonal: the same both ways up to round-off
 			const Real perVolume = sampled[c] > 0 ? dt / sampled[c] : 0;
 			// Z_d over (Σ, g^s, g^w): Σᵀ R_ss Σ + Σᵀ R g + (R g)ᵀ Σ (the surface terms), g_Jᵀ R_I g_K (the gradient form's
-			// true lumped share), − Δt λ_I a_J a_K / V^w_I (the share L's mobility implies)
-			Real Z[3][3][3];
+			// true lumped share), − Δt λ_I a_J a_K / V^w_I (the share L's mobility implies). With θ < 1, over
+			// (Σ, g^s, g^w, P): F's grains' row c_s·u and water's row c_w·u, c_s = (θ, θ, 0, 1 − θ) and
+			// c_w = (1 − θ, 1 − θ, 1, −(1 − θ)), so Z = R_ss c_s c_sᵀ + R_sw (c_s c_wᵀ + c_w c_sᵀ) + R_ww c_w c_wᵀ − q a aᵀ
+			// with a = (0, 1, 1, 0) (at θ = 1 the 3 × 3 form above, P's row and column zero)
+			Real Z[3][4][4];
 			for (int d = 0; d < 3; ++d) {
 				const Real q = perVolume * system.mobility[I][d];
-				const Real zd[3][3] = { { ss[I][d], ss[I][d], sw[I][d] }, { ss[I][d], ss[I][d] - q, cross[d] - q }, { sw[I][d], cross[d] - q, ww[I][d] - q } };
-				for (int e = 0; e < 3; ++e)
-					for (int f = 0; f < 3; ++f) Z[d][e][f] = zd[e][f];
-			}
-			for (int x = 0; x < m; ++x) {
-				Real zu[9];
-				for (int d = 0; d < 3; ++d)
-					for (int e = 0; e < 3; ++e) zu[3 * d + e] = Z[d][e][0] * u[3 * d][x] + Z[d][e][1] * u[3 * d + 1][x] + Z[d][e][2] * u[3 * d + 2][x];
-				const int a = rowOf[x];
-				if (blockOf[a] < 0) {
-					blockOf[a] = static_cast<int>(used++);
-					if (blocks.size() < used * blockSlots) blocks.resize(used * blockSlots, 0); // kept zero between steps: grown only
+				if (parts == 3) {
+					const Real zd[3][3] = { { ss[I][d], ss[I][d], sw[I][d] }, { ss[I][d], ss[I][d] - q, cross[d] - q }, { sw[I][d], cross[d] - q, ww[I][d] - q } };
+					for (int e = 0; e < 3; ++e)
+						for (int f = 0; f < 3; ++f) Z[d][e][f] = zd[e][f];
+					continue;
 				}
-				Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots - code[x];
-				// each pair's nine terms summed in order (a loop over the pairs the compiler vectorises),
-				// then added to the row's block
-				for (int y = x; y < m; ++y) {
-					Real value = 0;
-					for (int e = 0; e < 9; ++e) value += u[e][y] * zu[e];
-					pairValue[y] = value;
-				}
-				for (int y = x; y < m; ++y) block[code[y]] += pairValue[y]; // code[y] ≥ code[x]: offset order
+				const Real rest = 1 - theta, cs[4] = { theta, theta, 0, rest }, cw[4] = { rest, rest, 1, -rest }, a[4] = { 0, 1, 1, 0 };
+				for (int e = 0; e < 4; ++e)
+					for (int f = 0; f < 4; ++f)
+						Z[d][e][f] = ss[I][d] * cs[e] * cs[f] + cross[d] * (cs[e] * cw[f] + cw[e] * cs[f]) + ww[I][d] * cw[e] * cw[f] - q * a[e] * a[f];
 			}
+			// the pairs' values, with the component count known to the compiler (the hot loop below)
+			auto addPairs = [&](auto count) {
+				constexpr int P = decltype(count)::value, terms = 3 * P;
+				for (int x = 0; x < m; ++x) {
+					Real zu[terms];
+					for (int d = 0; d < 3; ++d)
+						for (int e = 0; e < P; ++e) {
+							Real sum = 0;
+							for (int f = 0; f < P; ++f) sum += Z[d][e][f] * u[P * d + f][x];
+							zu[P * d + e] = sum;
+						}
+					const int a = rowOf[x];
+					if (blockOf[a] < 0) {
+						blockOf[a] = static_cast<int>(used++);
+						if (blocks.size() < used * blockSlots) blocks.resize(used * blockSlots, 0); // kept zero between steps: grown only
+					}
+					Real* block = blocks.data() + static_cast<std::size_t>(blockOf[a]) * blockSlots - code[x];
+					// each pair's terms summed in order (a loop over the pairs the compiler vectorises),
+					// then added to the row's block
+					for (int y = x; y < m; ++y) {
+						Real value = 0;
+						for (int e = 0; e < terms; ++e) value += u[e][y] * zu[e];
+						pairValue[y] = value;
+					}
+					for (int y = x; y < m; ++y) block[code[y]] += pairValue[y]; // code[y] ≥ code[x]: offset order
+				}
+			};
+			if (parts == 4) addPairs(std::integral_constant<int, 4> {});
+			else addPairs(std::integral_constant<int, 3> {});
 		};
 		// the candidates split among the threads, each summing into its own blocks; then summed in thread order
 		const int threads = candidates.size() < parallelSurfaceNodes ? 1 : std::min<int>(omp_get_max_threads(), static_cast<int>(candidates.size()));

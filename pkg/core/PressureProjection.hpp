@@ -108,8 +108,8 @@ struct PressureSystem {
 		Real        value;       // [m³ s⁻¹ Pa⁻¹]
 	};
 	std::vector<NodePair> extraPairs; // added to K beyond the stored rows (the held surface's terms, eq. 8.5e)
-	struct SurfaceCoupling {          // per node I and neighbour J of eq. 8.5e: Σ_IJ, g^s_IJ, g^w_IJ [m²]
-		Vec3 surface = Vec3::Zero(), solid = Vec3::Zero(), water = Vec3::Zero();
+	struct SurfaceCoupling {          // per node I and neighbour J of eq. 8.5e: Σ_IJ, g^s_IJ, g^w_IJ and Σ_IJ's solid points' part (eq. 8.5j) [m²]
+		Vec3 surface = Vec3::Zero(), solid = Vec3::Zero(), water = Vec3::Zero(), grains = Vec3::Zero();
 	};
 	std::vector<std::array<SurfaceCoupling, 125>> surfaceCoupling; // meniscusPairs' scratch, kept from step to step
 	std::vector<Vec3>                             grainResponse[2]; // (same): Δt M⁻¹ on the grains for a unit force on the grains, on the water

@@ -335,6 +335,32 @@ TEST(CapillarySurface, ProjectionBoundHoldsWhereTheGrainsReachASurfaceNodeFarMor
 	EXPECT_LT(q.worst, 1);
 }
 
+// The other way round (theory.md eq. 8.5j): free water standing over the grains, so that the water
+// points fill a surface node's support far more than the grains, which reach it by the tails of their
+// weights (the sand pile's toe, where the seepage leaves onto the flume). The grains end δ above the node
+// plane one cell below the top (δ = 1e-4 h: the top node's skeleton mass ≈ 1e-10 of a full node's),
+// the water 0.625 h below the top, 8 points per cell and axis; the top node is a held candidate with θ =
+// V_I/V^w_I ≈ 0. Eq. 8.1 puts θ of the water points' reaction on the grains there, 1 − θ on the water;
+// eq. 8.5f put all of it on the grains, whose nodal response Δt/m^s is then 1e10 times a full node's, so
+// K's share at that node outgrew A's by the inverse of the grains' filling: a unit pressure at the top node
+// gave pᵀAp/pᵀKp = 1.4e-7 (δ = 1e-2 h: 1.4e-3), and on the sand pile under a crest head with
+// k = 0.1 m/s the CG stopped short of the tolerance (K's diagonal 9 orders apart) at 0.6 s. With F split by
+// θ as eq. 8.1 splits it: 0.126 at both δ (the covariance L_I − Δt a Λ_I aᵀ/V^w_I ⪰ 0 is what K has beyond
+// A there), the worst quotient 0.989 (0.256 before): K ⪰ A kept, and no longer far stiffer.
+TEST(CapillarySurface, ProjectionMatchesItsFormWhereTheWaterReachesASurfaceNodeFarMoreThanTheGrains)
+{
+	const int    perCell = 8;
+	const double h = CapillaryColumn::cell, top = CapillaryColumn::height, lift = 1e-4 * h;
+	CapillaryColumn c(true, 0, top - h, perCell);
+	for (Vec3& x : c.solid.position) x.z() += lift; // the grains' top δ above the plane below the top node's
+	c.fluid = fixtures::waterLattice(fixtures::lattice(Vec3::Zero(), Vec3(h, h, top - 0.625 * h), h, perCell), c.soil.porosity, c.water.density);
+	const ProjectionQuotients q = projectionQuotients(c, top);
+	std::printf("%zu free nodes, pᵀAp/pᵀKp at the top node %.3e, worst %.3f\n", q.freeNodes, q.onThePlane, q.worst);
+	EXPECT_TRUE(q.planeFree) << "the node the water reaches far more than the grains must be a held surface node";
+	EXPECT_LT(q.worst, 1);         // K ⪰ A: the projection is stable
+	EXPECT_GT(q.onThePlane, 0.1); // and K is not orders of magnitude stiffer than A at that node
+}
+
 // The water's surface on a node plane under a layer of wet grains δ thick (theory.md eq. 8.5i's last
 // paragraph): that plane's nodes are half filled and held; the plane above, which the water does not
 // reach, is fixed at p = 0 and has no row, and the wet solid points below it pull on its light skeleton
@@ -390,8 +416,9 @@ void expectPositiveDefinite(const TwoPhaseSolver& solver, int step, double& smal
 // K indefinite: smallest eigenvalue −7% of the largest at the second step, and the active set did not
 // settle in 2 of 40 steps. K is now positive definite by construction (theory.md eq. 8.5f: L's share
 // less its own lumped form is a covariance, the surface rows' exact Schur complement a Gram matrix).
-// Each step: the free rows' K is symmetric with positive eigenvalues (measured ≥ 6e-12 of the
-// largest: the film's light nodes are stiff), and the active set settles — a unique Signorini state
+// Each step: the free rows' K is symmetric with positive eigenvalues (measured ≥ 1.0e-2 of the largest;
+// 6e-12 and 5.9e-10 before eq. 8.5j split the film's reaction between grains and water as eq. 8.1 does:
+// the film's light nodes were stiff), and the active set settles — a unique Signorini state
 // (with K positive definite but the solve's tolerance held only at a typical node, it still flipped
 // in 1 of 40 steps: the light nodes' rows were kPa off; solvePressure now holds it at every node).
 TEST(CapillarySurface, SystemUnderAWetFilmIsPositiveDefiniteAndItsActiveSetSettles)
@@ -568,4 +595,5 @@ TEST(CapillarySurface, APeriodicAxisIsRefused)
 }
 
 } // namespace
+
 
