@@ -664,11 +664,16 @@ TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
 			if (e > worst) worst = e, worstAt = x, worstP = fluid.porePressure[p];
 			mean += e, ++count;
 		}
+		std::size_t fastest = 0;
+		for (std::size_t p = 0; p < fluid.size(); ++p)
+			if (fluid.velocity[p].norm() > fluid.velocity[fastest].norm()) fastest = p;
 		std::printf("t %.2f s: in %.3e out %.3e m²/s; |p − p_steady| worst %.3f mean %.4f γw H (worst at (%.3f, %.3f) m: %.0f Pa, steady %.0f); "
-		            "water inside %.4e outside %.4e kg; balance %.1e\n",
+		            "water inside %.4e outside %.4e kg; balance %.1e; fastest water point %.3f m/s at (%.3f, %.3f) m\n",
 		            r * every, (solver.injectedWaterMass() - injected) * perWidth, (solver.removedWaterMass() - removed) * perWidth, worst, mean / count,
 		            worstAt.x(), worstAt.z(), worstP, gammaW * (reference.at(worstAt.x(), worstAt.z()) - worstAt.z()), inside, outside,
-		            (stored - initial - solver.injectedWaterMass() + solver.removedWaterMass()) / initial);
+		            (stored - initial - solver.injectedWaterMass() + solver.removedWaterMass()) / initial, fluid.velocity[fastest].norm(),
+		            fluid.position[fastest].x(), fluid.position[fastest].z());
+		std::fflush(stdout);
 		injected = solver.injectedWaterMass(), removed = solver.removedWaterMass();
 	}
 }
