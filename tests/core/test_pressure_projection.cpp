@@ -492,8 +492,12 @@ TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionWithExtraPairsAcrossAPerio
 // wet solid points (eq. 8.1c), Σ_IJ = Σ_wp V [n S_J ∇S_I + S_I ∇S_J] + Σ_sp V (1 − n) S_J ∇S_I (the grains'
 // divergence-form share where eq. 8.1 samples it, less the gradient form's), g^s_IJ = −Σ_wp V (1 − n) S_I ∇S_J,
 // g^w_IJ = −Σ_wp V n S_I ∇S_J, V^w_I = Σ_wp V S_I;
-// per axis, f_J = (g^s_J + Σ_IJ, g^w_J) (Σ_IJ counted where it exceeds 1e-9 of I's largest: inside the
-// soil, where both sets sample alike, it is the points' round-off) and a_J = g^s_J + g^w_J; each pair of nodes J, K gains
+// per axis, the force eq. 8.1 puts on the grains and on the water at I for a unit pressure at J (eq. 8.5j),
+// f_J = (θ R_IJ + P_IJ, g^w_J + (1 − θ) R_IJ) with the water points' reaction R_IJ = Σ_wp V n ∇(S_I S_J), its
+// solid points' part P_IJ = Σ_sp V (1 − n) S_J ∇S_I and θ_I = min(1, V_I/V^w_I) (system.skeletonShare) where Σ_IJ
+// counts (above 1e-9 of I's largest: inside the soil, where both sets sample alike, it is the points'
+// round-off), the gradient form f_J = (θ g^s_J, g^w_J + (1 − θ) g^s_J) where it does not, and a_J = g^s_J + g^w_J;
+// each pair of nodes J, K gains
 // f_Jᵀ R_I f_K − Δt λ_I a_J a_K / V^w_I, R_I the nodal response Δt M_I⁻¹ with the walls' holds (as the
 // stage leaves it in system.grainResponse / waterResponse: the corrector's, tested there). Pairs with a
 // row fixed at p = 0 that is no candidate, tied to nothing, add exactly zero to what is solved and are
@@ -531,10 +535,11 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 		live[r] = !system.fixed[r] || candidate[r] || system.fixedValue[r] != 0 || (!system.ghostMaster.empty() && system.ghostMaster[r] >= 0);
 	std::map<std::pair<std::size_t, std::size_t>, Real> expected;
 	long                                                withSurface = 0, wetSolidPoints = 0, drySolidPoints = 0; // point-node incidences
+	long                                                partlyCovered = 0; // candidates with θ_I < 1 (eq. 8.5j's split)
 	for (std::size_t r = 0; r < active; ++r) {
 		if (!candidate[r]) continue;
 		const std::size_t I = system.node[r];
-		std::map<std::size_t, Vec3> surface, gs, gw; // per node J
+		std::map<std::size_t, Vec3> surface, gs, gw, reaction, grains; // per node J
 		Real                        supported = 0;    // V^w_I
 		// a point's 27 nodes, weights and gradients, its interpolated porosity (clamped as the stage
 		// clamps it) and skeleton wetting (eq. 8.1c); returns the place of I among its nodes, or −1
@@ -566,10 +571,11 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 			const Real V = scene.fluid.volume[p];
 			supported += V * N[i];
 			for (std::size_t j = 0; j < node.size(); ++j) {
-				for (auto* sum : { &surface, &gs, &gw }) sum->try_emplace(node[j], Vec3::Zero()); // Eigen leaves a new Vec3 unset
+				for (auto* sum : { &surface, &gs, &gw, &reaction, &grains }) sum->try_emplace(node[j], Vec3::Zero()); // Eigen leaves a new Vec3 unset
 				surface[node[j]] += V * (n * dN[i] * N[j] + N[i] * dN[j]);
 				gs[node[j]] -= V * (1 - n) * N[i] * dN[j];
 				gw[node[j]] -= V * n * N[i] * dN[j];
+				reaction[node[j]] += V * n * (dN[i] * N[j] + N[i] * dN[j]);
 			}
 		}
 		for (std::size_t p = 0; p < scene.solid.size(); ++p) {
@@ -581,14 +587,17 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 			}
 			++wetSolidPoints;
 			for (std::size_t j = 0; j < node.size(); ++j) {
-				for (auto* sum : { &surface, &gs, &gw }) sum->try_emplace(node[j], Vec3::Zero());
+				for (auto* sum : { &surface, &gs, &gw, &reaction, &grains }) sum->try_emplace(node[j], Vec3::Zero());
 				surface[node[j]] += scene.solid.volume[p] * (1 - n) * N[j] * dN[i];
+				grains[node[j]] += scene.solid.volume[p] * (1 - n) * N[j] * dN[i];
 			}
 		}
 		Real largest = 0;
 		for (const auto& [J, value] : surface) largest = std::max(largest, value.norm());
 		if (!(largest > 0)) continue;
 		++withSurface;
+		const Real theta = system.skeletonShare[I];
+		partlyCovered += theta < 1;
 		// Δt/V^w_I; none where I's support holds water points only at its edge (S_I = 0, ∇S_I ≠ 0)
 		const Real perVolume = supported > 0 ? scene.dt / supported : 0;
 		const Vec3 ss = system.grainResponse[0][I], sw = system.grainResponse[1][I], ws = system.waterResponse[0][I], ww = system.waterResponse[1][I];
@@ -599,8 +608,11 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 				if (rJ < 0 || rK < 0 || rJ > rK || !live[static_cast<std::size_t>(rJ)] || !live[static_cast<std::size_t>(rK)]) continue;
 				Real value = 0;
 				for (int d = 0; d < 3; ++d) {
-					const Real fJs = gs[J][d] + (surfaceJ.norm() > 1e-9 * largest ? surfaceJ[d] : 0), fJw = gw[J][d];
-					const Real fKs = gs[K][d] + (surfaceK.norm() > 1e-9 * largest ? surfaceK[d] : 0), fKw = gw[K][d];
+					const bool countsJ = surfaceJ.norm() > 1e-9 * largest, countsK = surfaceK.norm() > 1e-9 * largest;
+					const Real fJs = countsJ ? theta * reaction[J][d] + grains[J][d] : theta * gs[J][d];
+					const Real fJw = gw[J][d] + (1 - theta) * (countsJ ? reaction[J][d] : gs[J][d]);
+					const Real fKs = countsK ? theta * reaction[K][d] + grains[K][d] : theta * gs[K][d];
+					const Real fKw = gw[K][d] + (1 - theta) * (countsK ? reaction[K][d] : gs[K][d]);
 					const Real cross = 0.5 * (sw[d] + ws[d]);
 					value += fJs * (ss[d] * fKs + cross * fKw) + fJw * (cross * fKs + ww[d] * fKw)
 					         - perVolume * system.mobility[I][d] * (gs[J][d] + gw[J][d]) * (gs[K][d] + gw[K][d]);
@@ -611,6 +623,7 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 	EXPECT_GT(withSurface, 20); // the top's nodes and the walls' (the box's points end 3 cm inside them)
 	EXPECT_GT(wetSolidPoints, 100); // the grains' share is sampled at the solid points
 	EXPECT_GT(drySolidPoints, 0);   // and eq. 8.1c's cut is exercised
+	EXPECT_GT(partlyCovered, 0);    // and eq. 8.5j's split of the reaction (θ_I < 1)
 	Real scale = 0;
 	for (const auto& [pair, value] : expected) scale = std::max(scale, std::abs(value));
 	ASSERT_GT(scale, 0);
@@ -623,7 +636,7 @@ void expectMeniscusPairsAreTheirDefinition(int threads)
 	}
 	for (const auto& [pair, value] : emitted) EXPECT_TRUE(expected.count(pair)) << "a pair the definition has not: rows " << pair.first << ", " << pair.second;
 	EXPECT_GT(checked, 1000);
-	std::printf("%ld candidate nodes with surface terms, %zu pairs, %ld of them above 1e-6 of the largest\n", withSurface, pairs.size(), checked);
+	std::printf("%ld candidate nodes with surface terms (%ld with θ < 1), %zu pairs, %ld of them above 1e-6 of the largest\n", withSurface, partlyCovered, pairs.size(), checked);
 }
 
 TEST(CapillarySurfacePairs, AreTheirDefinitionOnOneThread) { expectMeniscusPairsAreTheirDefinition(1); }
