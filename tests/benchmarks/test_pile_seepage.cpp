@@ -173,6 +173,18 @@ struct ScreenedSlabHead {
 	}
 };
 
+// The pile's slice, `length` long and one cell `h` thick, 0.2 m high: the base fixed and impermeable, the
+// top free, the inflow face x = 0 a reservoir at `H` that supplies water points (eq. 2.5), the far face smooth.
+Domain pileSlice(double length, double h, double H)
+{
+	Domain d = fixtures::columnDomain(Vec3(length, h, 0.2), h);
+	d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
+	d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Free };
+	fixtures::reservoirFace(d, Face::XMin, H, true);
+	d.boundaries.walls[static_cast<int>(Face::XMax)] = { SolidWall::Slip, WaterWall::Free };
+	return d;
+}
+
 void expectPileSeepageIsTheLaplaceSolution(bool subscales)
 {
 	const double    g = 9.81, length = 0.6, k = 1e-3, h = 0.01;
@@ -196,11 +208,7 @@ void expectPileSeepageIsTheLaplaceSolution(bool subscales)
 		solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
 		fluid.porePressure[p] = gammaW * (pile.surface(x.x()) - x.z());
 	}
-	Domain d = fixtures::columnDomain(Vec3(length, h, 0.2), h);
-	d.boundaries.walls[static_cast<int>(Face::ZMin)]            = { SolidWall::Fixed, WaterWall::Impermeable };
-	d.boundaries.walls[static_cast<int>(Face::ZMax)]            = { SolidWall::Free, WaterWall::Free };
-	fixtures::reservoirFace(d, Face::XMin, H, true);
-	d.boundaries.walls[static_cast<int>(Face::XMax)]            = { SolidWall::Slip, WaterWall::Free };
+	Domain d = pileSlice(length, h, H);
 	SolverSettings s;
 	s.gravity = Vec3(0, 0, -g);
 	s.scheme  = TimeScheme::SemiImplicit;
@@ -631,11 +639,7 @@ TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
 		solid.effectiveStress[p] << k0 * sz, k0 * sz, sz, 0, 0, 0;
 		fluid.porePressure[p] = std::min(pw, gammaW * (H * std::sqrt(std::max(0.0, 1 - x.x() / pile.toe())) - x.z()));
 	}
-	Domain d = fixtures::columnDomain(Vec3(length, h, 0.2), h);
-	d.boundaries.walls[static_cast<int>(Face::ZMin)] = { SolidWall::Fixed, WaterWall::Impermeable };
-	d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Free };
-	fixtures::reservoirFace(d, Face::XMin, H, true);
-	d.boundaries.walls[static_cast<int>(Face::XMax)] = { SolidWall::Slip, WaterWall::Free };
+	Domain d          = pileSlice(length, h, H);
 	d.removeFreeWater = true;
 	SolverSettings s;
 	s.gravity          = Vec3(0, 0, -g);
