@@ -384,9 +384,9 @@ namespace stages {
 				rowOf[m]                = row;
 				code[m]                 = ((o / 25) * width[1] + (o / 5) % 5) * width[0] + o % 5; // the offset + (2, 2, 2) in the radix W
 				for (int d = 0; d < 3; ++d) {
-					Real* ud = &u[parts * d][0];
-					ud[m] = counts ? J.surface[d] : 0, ud[125 + m] = J.solid[d], ud[250 + m] = J.water[d];
-					if (parts == 4) ud[375 + m] = counts ? J.grains[d] : 0;
+					const int e = parts * d; // axis d's components (Σ, g^s, g^w[, P])
+					u[e][m] = counts ? J.surface[d] : 0, u[e + 1][m] = J.solid[d], u[e + 2][m] = J.water[d];
+					if (parts == 4) u[e + 3][m] = counts ? J.grains[d] : 0;
 				}
 				++m;
 			}
