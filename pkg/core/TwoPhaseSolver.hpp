@@ -54,7 +54,7 @@ struct Domain {
 	BoundaryConditions     boundaries;
 	std::vector<WaterSink> sinks;                    // water points entering one are removed
 	bool                   removeWaterLeavingGrid = true; // else a water point leaving the grid stops the run
-	bool                   removeFreeWater = false;       // remove water points with no solid in their stencil (n = 1)
+	bool                   removeFreeWater = false;       // remove water points that have left the soil: centre outside the skeleton, or no solid in the stencil (n = 1)
 };
 
 // Time-step limits of the current state (theory.md §5, eqs. 5.1–5.2), before the safety factor.

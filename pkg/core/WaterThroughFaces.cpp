@@ -93,13 +93,16 @@ void TwoPhaseSolver::removeOutflowingWater()
 		for (std::size_t p = 0; p < n; ++p) {
 			bool out = false;
 			for (const WaterSink& sink : domain_.sinks) out = out || sink.contains(w->position[p]);
-			// n = 1 exactly when no node of the point's stencil carries solid (eq. 4.5, this step)
+			// Water whose centre has left the skeleton has left the soil: into the filtering cloth
+			// (removeFreeWater, eq. 2.4: kept while a grain's weight still reached its nodes, it read the
+			// soil's porosity there and its Darcy drag flushed the surface's grains) or, under still water
+			// (eq. 1.9), into the still water, which the model does not carry (weightless, it would pile
+			// up on the surface). Not in an inflow face's cell, whose water is the reservoir's (eq. 2.5:
+			// removed there, a buffer in a loosened crest was grown again every step). Free water
+			// (n = 1, eq. 4.5: no solid in the stencil) goes to the cloth wherever it lies.
 			out = out || (domain_.removeFreeWater && w->porosity[p] >= 1);
-			// under still water (eq. 1.9) water whose centre has left the skeleton has joined the
-			// still water, which the model does not carry (weightless, it would pile up on the surface);
-			// not in an inflow face's cell, whose water is the reservoir's (eq. 2.5: removed there, a
-			// buffer in a loosened crest was grown again every step)
-			out = out || (domain_.boundaries.submerged() && !domain_.boundaries.withinACellOfInflowFace(grid_, w->position[p]) && !skeletonHolds(w->position[p]));
+			if (!out && (domain_.removeFreeWater || domain_.boundaries.submerged()))
+				out = !domain_.boundaries.withinACellOfInflowFace(grid_, w->position[p]) && !skeletonHolds(w->position[p]);
 			// the part of a point beyond a drained face has left through it (eq. 2.4)
 			for (int f = 0; f < faceCount && !out; ++f) {
 				if (domain_.boundaries.walls[f].water != WaterWall::Drained || grid_.periodic[f / 2]) continue;

@@ -254,6 +254,53 @@ TEST(Outflow, ThePartOfAPointBeyondADrainedFaceLeavesWithItsMass)
 	EXPECT_NEAR(std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0) + solver.removedWaterMass(), total, 1e-12 * total);
 }
 
+// Water that has seeped out of the soil is taken by the filtering cloth (`removeFreeWater`, theory.md
+// eq. 2.4): a row of free water whose centres lie a quarter cell above a saturated block's top has
+// left the soil, although the grains' GIMP weights still reach its nodes (its porosity, eq. 4.5,
+// reads below 1, so a rule "no solid in the stencil" keeps it); it leaves in the first step with
+// its mass counted, and the block keeps every water point of its pores.
+TEST(Outflow, WaterThatHasSeepedOutOfTheSoilLeavesIntoTheFilteringCloth)
+{
+	const double    h = 0.05, top = 0.2, g = 9.81;
+	SoilParameters  soil;
+	WaterParameters water;
+	soil.porosity = 0.4;
+	const auto    grains = fixtures::lattice(Vec3::Zero(), Vec3(h, h, top), h, 2);
+	const auto    wet    = fixtures::lattice(Vec3::Zero(), Vec3(h, h, top + h / 2), h, 2); // one row more: the seeped water
+	auto run = [&](bool cloth, WaterPointSet& fluid, double& removed) {
+		SolidPointSet solid = fixtures::solidLattice(grains, soil.porosity, soil.density);
+		fluid               = fixtures::waterLattice(wet, soil.porosity, water.density);
+		fixtures::setGeostatic(solid, fluid, soil, water, g, top);
+		const double V = grains.spacing * grains.spacing * grains.spacing;
+		for (std::size_t p = 0; p < fluid.size(); ++p)
+			if (fluid.position[p].z() > top) fluid.mass[p] = water.density * V, fluid.porosity[p] = 1, fluid.porePressure[p] = 0;
+		Domain d = fixtures::columnDomain(Vec3(h, h, 2 * top), h);
+		d.removeFreeWater = cloth;
+		SolverSettings s;
+		s.gravity = Vec3(0, 0, -g);
+		TwoPhaseSolver solver(d, s);
+		solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+		const double initial = std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0);
+		solver.step(0.5 * solver.timeStepLimits().critical);
+		removed = solver.removedWaterMass();
+		EXPECT_NEAR(std::accumulate(fluid.mass.begin(), fluid.mass.end(), 0.0) + removed, initial, 1e-12 * initial);
+	};
+	const std::size_t inSoil = grains.positions.size(), seeped = wet.positions.size() - inSoil;
+	WaterPointSet     fluid;
+	double            removed = 0;
+	run(false, fluid, removed);
+	ASSERT_EQ(fluid.size(), inSoil + seeped);
+	double seepedPorosity = 0;
+	for (std::size_t p = 0; p < fluid.size(); ++p)
+		if (fluid.position[p].z() > top) seepedPorosity = std::max(seepedPorosity, fluid.porosity[p]);
+	std::printf("seeped row's porosity (eq. 4.5) %.4f\n", seepedPorosity);
+	EXPECT_LT(seepedPorosity, 1); // the case "no solid in the stencil" misses
+	run(true, fluid, removed);
+	EXPECT_EQ(fluid.size(), inSoil);
+	EXPECT_NEAR(removed, seeped * water.density * grains.spacing * grains.spacing * grains.spacing, 1e-12);
+	for (std::size_t p = 0; p < fluid.size(); ++p) EXPECT_LT(fluid.position[p].z(), top);
+}
+
 // An interrupt (Ctrl-C in the binding) is a flag advance() polls before each sub-step: set, no
 // sub-step is taken and the state is untouched; clear, all planned sub-steps run and the time is the
 // whole dt to the bit (the binding adds it to mpmTime, which must equal O.time).

@@ -247,8 +247,10 @@ def test_inflow_face_supplies_water_points_under_a_raised_head_and_the_balance_c
 
 
 def test_free_water_is_removed_when_asked_and_water_in_soil_is_not():
-    """removeFreeWater (eq. 2.4): water with no solid in its stencil (n = 1) leaves the model, as
-    into a filtering cloth; saturated soil keeps all of its water."""
+    """removeFreeWater (eq. 2.4): water that has left the soil (here: with no solid in its stencil,
+    n = 1) leaves the model, as into a filtering cloth; saturated soil keeps all of its water (its
+    centres lie in the skeleton). Water just outside the soil's surface: the C++ test
+    Outflow.WaterThatHasSeepedOutOfTheSoilLeavesIntoTheFilteringCloth."""
     fluid = water_only_block(0.3)
     initial = fluid.mass.sum()
     engine = w.MpmTwoPhaseEngine(label="mpm", gravity=G, domainMin=(0, 0, 0), domainMax=(0.1, 0.1, 0.3), cellSize=0.05,
