@@ -4,9 +4,10 @@ with the head rise shortened for CI (conftest.QUICK_SANDPILE_HISTORY: 20 s inste
 seconds of real seepage, not the 200× compressed history): it runs the whole history, writes every
 output, keeps the water mass balance closed, stands while the head is low (also by Bishop's method on
 its own pressures), fails once the head has risen with a slip that accelerates and then runs out, its
-first slide a toe slide on a band, its onset head within 10% of the limit-equilibrium one, and the pressure
-behind the inflow face follows the head. Not met today (xfail, issue 15): one sliding surface to the end
-(the pile flattens, its band threshold exceeded in most of it). The default 60 s history's numbers are in
+first slide a toe slide on a band, and the pressure behind the inflow face follows the head. Not met today
+(xfail, issue 15): one sliding surface to the end (the pile flattens, its band threshold exceeded in most of
+it), and the onset head within 10% of the limit-equilibrium one (the pile stands past Bishop's F = 1 since
+the filtering cloth takes the water that seeps out, theory.md eq. 2.4). The default 60 s history's numbers are in
 doc/sandpile.md."""
 import csv
 import json
@@ -173,18 +174,24 @@ def test_one_sliding_surface_reaches_the_base_near_the_toe(quick_run):
     assert surface["scarp_x_m"] < surface["exit_x_m"] - 2 * cell, surface
 
 
+ONSET_PAST_LEM = ("issue 15: since the filtering cloth takes the water that seeps out (theory.md eq. 2.4, 2026-12-02) the pile "
+                  "stands past Bishop's F = 1 on its own pressures: compliance onset 0.0561 m against Bishop's 0.0450 m (+25%) on "
+                  "this 20 s rise, F 0.77 on the onset's pressures; on the 60 s history 0.0611 against 0.0418 m (+46%), F 0.80. "
+                  "The agreement before (+9.1%, F 0.96) came with seeped water kept at the toe, flushing its grains")
+
+
+@pytest.mark.xfail(strict=True, reason=ONSET_PAST_LEM)
 def test_onset_head_within_ten_percent_of_limit_equilibrium(quick_run):
     """The onset (the slope face's compliance, a kinematic criterion without a millimetre threshold)
-    within 10% of the head at which Bishop's factor on the run's own pressure field crosses 1 (issue 15):
-    measured +9.1% on this 20 s rise (0.0507 against 0.0465 m; Bishop is evaluated at every record, 1.8 mm
-    of head, and interpolated) and +0.1% on the default 60 s history (0.04151 against 0.04146 m). And the
-    same check where it is well conditioned: Bishop's factor on the onset record's own pressures lies
-    within 10% of 1 — the model fails where limit equilibrium says it should (measured 0.96; 0.995 on the
-    60 s history). Where F runs flat near 1 the crossing's head is not: at 3 points per cell F stays at
+    within 10% of the head at which Bishop's factor on the run's own pressure field crosses 1 (issue 15;
+    Bishop is evaluated at every record, 1.8 mm of head, and interpolated). And the same check where it
+    is well conditioned: Bishop's factor on the onset record's own pressures lies within 10% of 1 — the
+    model fails where limit equilibrium says it should. Measured +9.1% (0.0507 against 0.0465 m) with F
+    0.96 while seeped water stayed at the toe; +25% with F 0.77 since the cloth takes it (ONSET_PAST_LEM). Where F runs flat near 1 the crossing's head is not: at 3 points per cell F stays at
     0.99–1.08 from 0.049 to 0.054 m of head, and with F sampled every 5 records (9 mm of head) its
     crossing read 0.073 m against the onset's 0.054 m (doc/tradeoffs.md). The kinetic onset, the slide's acceleration, is not held to either
-    (−2.6% here, +47% on the 60 s history: the slump at the toe accelerates only once it has spread up the
-    slope)."""
+    (before the cloth took the seeped water −2.6% here, +47% on the 60 s history: the slump at the toe
+    accelerated only once it had spread up the slope; since, +21% and +33%)."""
     _, summary, _ = quick_run
     assert summary["onset_head_m"] is not None and summary["lem_onset_head_m"] is not None
     assert abs(summary["onset_head_m"] - summary["lem_onset_head_m"]) <= 0.1 * summary["lem_onset_head_m"]
