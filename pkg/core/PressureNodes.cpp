@@ -170,6 +170,36 @@ namespace stages {
 	}
 
 
+	// A node beyond an impermeable wall (the padding) that water points reach by more than round-off: a
+	// flow along the wall draws the row next to it closer than its half-length (a pile's base under
+	// seepage). Held at p = 0 it was a drain behind the wall; it takes the pressure of the wall-plane node
+	// it lies beyond (eq. 8.5k: tied as eq. 8.5b ties a surface node, c = 1). Beyond a drained or free wall
+	// along any axis it keeps that wall's condition.
+	void tieBeyondImpermeableWalls(const GridGeometry& grid, const BoundaryConditions& bcs, const std::vector<char>& surface, PressureSystem& system)
+	{
+		for (std::size_t r = 0; r < system.node.size(); ++r) {
+			if (!surface[r] || system.ghostMaster[r] >= 0) continue;
+			const std::array<int, 3> idx = grid.indices(system.node[r]);
+			std::array<int, 3>       onWall = idx;
+			bool                     beyond = false, otherWall = false;
+			for (int axis = 0; axis < 3; ++axis) {
+				if (grid.periodic[axis]) continue;
+				for (int side = 0; side < 2; ++side) {
+					const int wall = side == 0 ? grid.wallNode[axis] : grid.upperWallNode[axis];
+					if (side == 0 ? idx[axis] >= wall : idx[axis] <= wall) continue;
+					beyond       = true;
+					otherWall    = otherWall || bcs.walls[2 * axis + side].water != WaterWall::Impermeable;
+					onWall[axis] = wall;
+				}
+			}
+			if (!beyond || otherWall) continue;
+			const int M = system.row[grid.index(onWall[0], onWall[1], onWall[2])];
+			if (M < 0) continue;
+			if (!system.fixed[M]) system.ghostMaster[r] = M, system.ghostFactor[r] = 1;
+			else if (system.ghostMaster[M] >= 0) system.ghostMaster[r] = system.ghostMaster[M], system.ghostFactor[r] = system.ghostFactor[M];
+		}
+	}
+
 	template <class Kernel>
 	void classifyPressureNodes(const GridGeometry& grid, const GridFields& fields, const std::vector<WaterPointSet*>& sets, const BoundaryConditions& bcs,
 	                           const Vec3& gravity, Real waterDensity, PressureSystem& system)
@@ -239,6 +269,7 @@ namespace stages {
 			}
 		}
 		tieSurfaceNodes(grid, fields, sets, waterDensity, surface, system);
+		tieBeyondImpermeableWalls(grid, bcs, surface, system);
 		system.surface = std::move(surface); // not read here after the ties
 	}
 

@@ -301,6 +301,49 @@ TEST(Outflow, WaterThatHasSeepedOutOfTheSoilLeavesIntoTheFilteringCloth)
 	for (std::size_t p = 0; p < fluid.size(); ++p) EXPECT_LT(fluid.position[p].z(), top);
 }
 
+// A flow along an impermeable wall draws the row of water points next to it closer than their
+// half-length, so that their domains reach past the wall onto the padding nodes (the pile's base under
+// seepage: its bottom row at 0.1–0.8 mm of its 2.5 mm by 0.5 s, theory.md §8 Open). The wall lets no
+// water through, so those nodes must not act as a drain: they take the wall-plane node's pressure
+// (eq. 8.5k). A saturated column at rest with every water point half its half-length lower (the
+// bottom row's domains l/2 past the base, the rows still tiling the water's height): held at p = 0,
+// the padding drained the base (measured on the code before eq. 8.5k: 36% of γw H off, the water at
+// 3.1e-2 m/s, 1.25 k/n, its volume −2.1e-4 in 0.054 s); tied, it stays hydrostatic within 0.3% of γw H
+// and moves at 9e-4 m/s — not exactly at rest, since a point past the wall reads the wall's pressure,
+// not the hydrostatic one a little deeper (the tie is a zero normal gradient, first order).
+TEST(ImpermeableWall, WaterPointsReachingPastItFindNoDrainBehindIt)
+{
+	const double    g = g0, h = 0.05, H = 20 * h, k = 1e-2;
+	SoilParameters  soil;
+	WaterParameters water;
+	soil.intrinsicPermeability = k * water.viscosity / (water.density * g);
+	const auto    l     = fixtures::lattice(Vec3::Zero(), Vec3(h, h, H), h, 2);
+	SolidPointSet solid = fixtures::solidLattice(l, soil.porosity, soil.density);
+	WaterPointSet fluid = fixtures::waterLattice(l, soil.porosity, water.density);
+	fixtures::setGeostatic(solid, fluid, soil, water, g, H);
+	for (std::size_t p = 0; p < fluid.size(); ++p) {
+		fluid.position[p].z() -= fluid.halfLength[p].z() / 2;
+		fluid.porePressure[p] = water.density * g * (H - fluid.position[p].z());
+	}
+	SolverSettings s;
+	s.gravity = Vec3(0, 0, -g);
+	TwoPhaseSolver solver(fixtures::columnDomain(Vec3(h, h, H), h), s);
+	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
+	const double dt = 0.5 * solver.timeStepLimits().critical;
+	for (int i = 0; i < 200; ++i) solver.step(dt);
+	double pressureError = 0, speed = 0;
+	for (std::size_t p = 0; p < fluid.size(); ++p) {
+		pressureError = std::max(pressureError, std::abs(fluid.porePressure[p] - water.density * g * (H - fluid.position[p].z())) / (water.density * g * H));
+		speed         = std::max(speed, fluid.velocity[p].norm());
+	}
+	std::printf("water points l/2 past an impermeable base: max |p - γw d| %.2e of γw H, max water speed %.2e m/s (k/n = %.1e) after %.3f s\n", pressureError,
+	            speed, k / soil.porosity, 200 * dt);
+	// hydrostatic within 1% of γw H (the bound at rest), and the water moving at under a tenth of
+	// the pore speed k/n that a unit gradient drives (a drain at the base drove 1.25 k/n)
+	EXPECT_LT(pressureError, 0.01);
+	EXPECT_LT(speed, 0.1 * k / soil.porosity);
+}
+
 // An interrupt (Ctrl-C in the binding) is a flag advance() polls before each sub-step: set, no
 // sub-step is taken and the state is untouched; clear, all planned sub-steps run and the time is the
 // whole dt to the bit (the binding adds it to mpmTime, which must equal O.time).
