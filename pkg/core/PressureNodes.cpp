@@ -175,10 +175,16 @@ namespace stages {
 	// seepage). Held at p = 0 it was a drain behind the wall; it takes the pressure of the wall-plane node
 	// it lies beyond (eq. 8.5k: tied as eq. 8.5b ties a surface node, c = 1). Beyond a drained or free wall
 	// along any axis it keeps that wall's condition.
-	void tieBeyondImpermeableWalls(const GridGeometry& grid, const BoundaryConditions& bcs, const std::vector<char>& surface, PressureSystem& system)
+	void tieBeyondImpermeableWalls(const GridGeometry& grid, const GridFields& fields, const BoundaryConditions& bcs, const std::vector<char>& surface,
+	                               PressureSystem& system)
 	{
+		// water volume, as a share of a cell's, below which a padding node is reached only by the
+		// round-off tail of the weights (a domain ending on the wall plane): it keeps p = 0, which then
+		// couples to nothing
+		constexpr Real reachedPadding = 1e-12;
+		const Real     cell           = grid.cellSize * grid.cellSize * grid.cellSize;
 		for (std::size_t r = 0; r < system.node.size(); ++r) {
-			if (!surface[r] || system.ghostMaster[r] >= 0) continue;
+			if (!surface[r] || system.ghostMaster[r] >= 0 || !(fields.water[system.node[r]].volume > reachedPadding * cell)) continue;
 			const std::array<int, 3> idx = grid.indices(system.node[r]);
 			std::array<int, 3>       onWall = idx;
 			bool                     beyond = false, otherWall = false;
@@ -269,7 +275,7 @@ namespace stages {
 			}
 		}
 		tieSurfaceNodes(grid, fields, sets, waterDensity, surface, system);
-		tieBeyondImpermeableWalls(grid, bcs, surface, system);
+		tieBeyondImpermeableWalls(grid, fields, bcs, surface, system);
 		system.surface = std::move(surface); // not read here after the ties
 	}
 
