@@ -267,9 +267,10 @@ namespace stages {
 				system.fixed[r] = 1;
 			} else {
 				// a free surface (eq. 2.3 at the node), or a node beyond a wall, whose support lies
-				// outside the domain and which points reach only by the round-off tail of their
+				// outside the domain and which points mostly reach only by the round-off tail of their
 				// weights: left free, its pressure is all but undetermined, and a solid point a hair
-				// closer to the wall than its water point would pick it up
+				// closer to the wall than its water point would pick it up (one that water reaches past
+				// an impermeable wall by more is tied to the wall's node after the surface ties, eq. 8.5k)
 				const Real full = grid.inDomainSupportVolume(idx[0], idx[1], idx[2]);
 				if (!(full > 0) || fields.water[I].volume < freeSurfaceFilling * full) system.fixed[r] = 1, surface[r] = 1;
 			}
