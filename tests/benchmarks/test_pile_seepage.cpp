@@ -602,29 +602,33 @@ struct CapillaryPileHead {
 	}
 };
 
-// Not a test: the study of theory.md §8 Open, "The pile's seepage under a crest head, with its capillary
-// surface" (issue 14's pile criterion: 1 s under a constant head at the crest, the pressure against steady
-// seepage of the section, toe |ṗ|, inflow = outflow, water points crossing both faces). The pile of PileSeepage
-// above in a slice one cell thick, elastic, real water, the capillary surface (theory.md eq. 8.5e) and the
-// filtering cloth (removeFreeWater), with k = MPM_PILE_K (default 0.1 m/s: at the pile's 1e-3 m/s no water
-// point leaves in 1 s) and h = MPM_PILE_CELL (default 0.02 m), for MPM_PILE_TIME s (default 1); with
-// MPM_PILE_STABILISATION = c > 0 the projection takes eq. 8.6b's quasi-static stabilisation c κ/μw instead of
-// the default dynamic subscales (eq. 8.6c). The pressure is sampled every MPM_PILE_SAMPLE s (default 0.002:
-// a record's end alone hid one-step spikes, theory.md §8 Open). Every 0.05 s it prints the water injected and
-// removed as points (per unit width), over the record's samples the worst and mean |p − p_steady| over the
-// water points inside the pile's outline (γw H) and how many samples had a point beyond 0.1 γw H, where the
-// record's worst lay, the nodes' roughness (|p_I − the mean of its four neighbours| over full interior nodes,
-// γw H: zero for a linear field), the toe's |ṗ| (the solve's pressure at the node nearest (toe − 3h, h), between
-// samples and over the record), the water inside and outside the outline, the balance and the fastest water
-// point. About 1 min on two cores at 2 cm, 5 min on one at 1 cm:
-//   mpm_benchmark_tests --gtest_also_run_disabled_tests --gtest_filter=PileSeepage.DISABLED_CapillarySurfaceUnderACrestHead
-TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
+// The pile of PileSeepage above under a constant head at its crest, in a slice one cell thick: elastic, real
+// water, the capillary surface (theory.md eq. 8.5e) and the filtering cloth (removeFreeWater), started from the
+// lesser of the steady pressures and a Dupuit table H √(1 − x/L). The pressure is sampled every `sample` s
+// against steady seepage of the section (a record's end alone hid one-step spikes, theory.md §8 Open) and
+// summed up per record of 0.05 s.
+struct CrestHeadRun {
+	double k = 0.1, h = 0.02, duration = 1, sample = 0.002, stabilisation = 0; // [m/s], [m], [s], [s], eq. 8.6b's c (0: eq. 8.6c)
+	bool   print = true;
+};
+struct CrestHeadRecord {
+	double t, in, out;                            // [s], the discharges in and out as points over the record [m² s⁻¹]
+	double worst, mean;                           // |p − p_steady| over the record's samples, γw H
+	int    beyond;                                // samples with a point beyond 0.1 γw H
+	double toeRecordRate;                         // |Δp| over the record / its length at the toe's node [Pa/s]
+};
+struct CrestHeadResult {
+	double                       inflowSteady; // the reference's discharge [m² s⁻¹]
+	double                       balance;      // (stored + removed − initial − injected)/initial at the end
+	std::vector<CrestHeadRecord> records;
+};
+
+CrestHeadResult runPileUnderACrestHead(const CrestHeadRun& run)
 {
-	auto         env = [](const char* name, double fallback) { const char* v = std::getenv(name); return v ? std::atof(v) : fallback; };
-	const double g = 9.81, length = 0.6, k = env("MPM_PILE_K", 0.1), h = env("MPM_PILE_CELL", 0.02), duration = env("MPM_PILE_TIME", 1.0), every = 0.05;
+	const double g = 9.81, length = 0.6, k = run.k, h = run.h, every = 0.05;
 	const Pile   pile;
 	const CapillaryPileHead reference(pile, pile.height, 0.001);
-	std::printf("steady seepage (1 mm): inflow %.4e, outflow %.4e m²/s at k = %g m/s\n", reference.inflow(k), reference.outflow(k), k);
+	if (run.print) std::printf("steady seepage (1 mm): inflow %.4e, outflow %.4e m²/s at k = %g m/s, h = %g m\n", reference.inflow(k), reference.outflow(k), k, h);
 	SoilParameters  soil;
 	WaterParameters water;
 	soil.youngModulus          = 20e6;
@@ -651,13 +655,11 @@ TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
 	s.gravity          = Vec3(0, 0, -g);
 	s.scheme           = TimeScheme::SemiImplicit;
 	s.capillarySurface = true;
-	if (const double c = env("MPM_PILE_STABILISATION", 0); c > 0) s.darcySubscales = false, s.darcyStabilisation = c;
+	if (run.stabilisation > 0) s.darcySubscales = false, s.darcyStabilisation = run.stabilisation;
 	TwoPhaseSolver solver(d, s);
 	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
 	double initial = 0;
 	for (double m : fluid.mass) initial += m;
-	double       injected = 0, removed = 0;
-	const double perWidth = 1 / (water.density * h * every); // kg per record → m²/s
 	// the nodes' roughness: |p_I − the mean of its four in-plane neighbours| over nodes whose support the water
 	// and the skeleton fill, free of every condition, with four such neighbours [Pa]
 	auto roughness = [&]() {
@@ -690,10 +692,12 @@ TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
 		return grid.index(i, grid.wallNode[1], grid.wallNode[2] + 1);
 	}();
 	auto toePressure = [&]() { return solver.pressureSystem().nodalPressure.empty() ? 0.0 : solver.pressureSystem().nodalPressure[toeNode]; };
-	const double sample  = env("MPM_PILE_SAMPLE", 0.002);
-	const int    samples = std::max(1, static_cast<int>(std::lround(every / sample)));
-	double       toeBefore = NAN, toeAtRecord = NAN; // no solve before the first step
-	for (int r = 1; r * every <= duration + 1e-9; ++r) {
+	const int       samples   = std::max(1, static_cast<int>(std::lround(every / run.sample)));
+	const double    perWidth  = 1 / (water.density * h * every); // kg per record → m²/s
+	double          toeBefore = NAN, toeAtRecord = NAN;           // no solve before the first step
+	double          injected = 0, removed = 0;
+	CrestHeadResult result { reference.inflow(k), 0, {} };
+	for (int r = 1; r * every <= run.duration + 1e-9; ++r) {
 		double worst = 0, mean = 0, worstP = 0, rough = 0, toeRate = 0, inside = 0, outside = 0, stored = 0;
 		Vec3   worstAt = Vec3::Zero();
 		int    beyond  = 0;
@@ -710,7 +714,7 @@ TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
 			}
 			if (count > 0) mean += sampleMean / count / samples; // no water inside the outline: nothing to compare
 			beyond += sampleWorst > 0.1;
-			rough = std::max(rough, roughness());
+			if (run.print) rough = std::max(rough, roughness());
 			const double toe = toePressure();
 			if (std::isfinite(toeBefore)) toeRate = std::max(toeRate, std::abs(toe - toeBefore) / (every / samples));
 			if (!std::isfinite(toeAtRecord)) toeAtRecord = toe;
@@ -723,19 +727,107 @@ TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
 		}
 		const double toeRecordRate = std::abs(toeBefore - toeAtRecord) / every; // the first record's from its first sample
 		toeAtRecord = toeBefore;
-		std::size_t fastest = 0;
-		for (std::size_t p = 0; p < fluid.size(); ++p)
-			if (fluid.velocity[p].norm() > fluid.velocity[fastest].norm()) fastest = p;
-		std::printf("t %.2f s: in %.3e out %.3e m²/s; |p − p_steady| worst %.3f mean %.4f γw H, %d of %d samples beyond 0.1 γw H "
-		            "(worst at (%.3f, %.3f) m: %.0f Pa, steady %.0f); roughness %.3f γw H; toe |dp/dt| %.0f Pa/s between samples, %.0f over the "
-		            "record; water inside %.4e outside %.4e kg; balance %.1e; fastest water point %.3f m/s at (%.3f, %.3f) m\n",
-		            r * every, (solver.injectedWaterMass() - injected) * perWidth, (solver.removedWaterMass() - removed) * perWidth, worst, mean, beyond, samples,
-		            worstAt.x(), worstAt.z(), worstP, gammaW * (reference.at(worstAt.x(), worstAt.z()) - worstAt.z()), rough / (gammaW * H), toeRate, toeRecordRate,
-		            inside, outside, (stored - initial - solver.injectedWaterMass() + solver.removedWaterMass()) / initial, fluid.velocity[fastest].norm(),
-		            fluid.position[fastest].x(), fluid.position[fastest].z());
-		std::fflush(stdout);
+		const CrestHeadRecord record { r * every, (solver.injectedWaterMass() - injected) * perWidth, (solver.removedWaterMass() - removed) * perWidth,
+			                           worst, mean, beyond, toeRecordRate };
+		result.records.push_back(record);
+		result.balance = (stored - initial - solver.injectedWaterMass() + solver.removedWaterMass()) / initial;
+		if (run.print) {
+			std::size_t fastest = 0;
+			for (std::size_t p = 0; p < fluid.size(); ++p)
+				if (fluid.velocity[p].norm() > fluid.velocity[fastest].norm()) fastest = p;
+			std::printf("t %.2f s: in %.3e out %.3e m²/s; |p − p_steady| worst %.3f mean %.4f γw H, %d of %d samples beyond 0.1 γw H "
+			            "(worst at (%.3f, %.3f) m: %.0f Pa, steady %.0f); roughness %.3f γw H; toe |dp/dt| %.0f Pa/s between samples, %.0f over the "
+			            "record; water inside %.4e outside %.4e kg; balance %.1e; fastest water point %.3f m/s at (%.3f, %.3f) m\n",
+			            record.t, record.in, record.out, worst, mean, beyond, samples, worstAt.x(), worstAt.z(), worstP,
+			            gammaW * (reference.at(worstAt.x(), worstAt.z()) - worstAt.z()), rough / (gammaW * H), toeRate, toeRecordRate, inside, outside,
+			            result.balance, fluid.velocity[fastest].norm(), fluid.position[fastest].x(), fluid.position[fastest].z());
+			std::fflush(stdout);
+		}
 		injected = solver.injectedWaterMass(), removed = solver.removedWaterMass();
 	}
+	return result;
+}
+
+// The discharges of a run's records from t = `from` on, averaged [m² s⁻¹]
+struct Discharges {
+	double in = 0, out = 0;
+};
+Discharges meanDischarges(const CrestHeadResult& r, double from)
+{
+	Discharges d;
+	int        n = 0;
+	for (const CrestHeadRecord& rec : r.records)
+		if (rec.t > from + 1e-9) d.in += rec.in, d.out += rec.out, ++n;
+	if (n > 0) d.in /= n, d.out /= n;
+	return d;
+}
+
+// Issue 14's pile criterion: the sand pile under a constant head at its crest for 1 s, with water points
+// crossing both faces. At the pile's own k = 1e-3 m/s none can leave through the slope in 1 s (the seepage
+// velocity k i/n is about 1 mm/s; the header above), so the run takes k = 1e-2 m/s, a coarse sand: 2.9649e-4
+// m²/s of steady seepage (the section's finite volumes with the capillary surface's Signorini conditions at
+// 1 mm), about 13 water points of h = 2 cm through the slope in 0.9 s. The steady heads do not depend on k.
+// Asserted, every 2 ms over the whole second and at every water point inside the pile's outline: |p −
+// p_steady| < 0.1 γw H (the issue's bound; measured ≤ 0.077, mean 0.4–0.8%); the toe's pressure (the node
+// nearest (toe − 3h, h)) changes by less than 1 kPa/s over every 0.05 s record after the first (measured ≤
+// 729 Pa/s); over 0.1–1 s the inflow as new points within 4% of steady (measured −1.9%; −1.5% at h = 1 cm) and
+// the outflow, as the points the filtering cloth takes, the inflow within the points' granularity (each leaves
+// whole: one point's water, (h/2)³ n ρw = 0.4 g, is 7.6% of the 0.9 s throughflow here, and the water inside
+// the outline wanders by ±1.5 points between records; measured +7.0%, one point); the water mass balance to
+// 1e-12. What this does not show (theory.md §8 Open): the issue's 2% between inflow and outflow needs more
+// points through the face than this second carries (h = 1 cm, k = 1e-1 m/s: +2.4%), and at k = 1e-1 m/s (a
+// gravel) the field holds on average but not at every point and sample (one-step spikes where the discrete
+// conditions change).
+TEST(PileSeepage, UnderACrestHeadWaterCrossesBothFacesAndThePressureIsSteadySeepage)
+{
+	CrestHeadRun run;
+	run.k = 1e-2, run.h = 0.02, run.duration = 1, run.sample = 0.002, run.print = false;
+	const CrestHeadResult r = runPileUnderACrestHead(run);
+	ASSERT_EQ(r.records.size(), 20u);
+	double worst = 0, toeRate = 0;
+	int    beyond = 0;
+	for (std::size_t i = 0; i < r.records.size(); ++i) {
+		worst = std::max(worst, r.records[i].worst), beyond += r.records[i].beyond;
+		if (i > 0) toeRate = std::max(toeRate, r.records[i].toeRecordRate); // the first record starts from the initial table
+	}
+	const Discharges q         = meanDischarges(r, 0.1);
+	const double     window    = 0.9, h = run.h, pointWater = std::pow(h / 2, 3) * 0.4 * 1000; // [s], [m], [kg]
+	const double     oneWindow = pointWater / (1000 * h * window);                               // one point per window [m² s⁻¹]
+	std::printf("pile under a crest head, k = %g m/s, h = %g m: worst |p − p_steady| %.3f γw H over %zu samples (%d beyond 0.1); toe |dp/dt| %.0f Pa/s; "
+	            "over 0.1-1 s in %.4e (%+.2f%% of steady %.4e), out %.4e m²/s (%+.2f%% of in; one point %.1f%%); balance %.1e\n",
+	            run.k, h, worst, 25 * r.records.size(), beyond, toeRate, q.in, 100 * (q.in / r.inflowSteady - 1), r.inflowSteady, q.out,
+	            100 * (q.out / q.in - 1), 100 * oneWindow / q.in, r.balance);
+	EXPECT_EQ(beyond, 0);
+	EXPECT_LT(worst, 0.10);
+	EXPECT_LT(toeRate, 1000.0);
+	EXPECT_NEAR(q.in, r.inflowSteady, 0.04 * r.inflowSteady);
+	EXPECT_GT(q.out, 0); // water points leave through the slope into the cloth
+	EXPECT_NEAR(q.out, q.in, 0.02 * q.in + oneWindow);
+	EXPECT_LT(std::abs(r.balance), 1e-12);
+}
+
+// Not a test: the study of theory.md §8 Open, "The pile's seepage under a crest head, with its capillary
+// surface": the run above with k = MPM_PILE_K (default 0.1 m/s, gravel), h = MPM_PILE_CELL (default 0.02 m),
+// MPM_PILE_TIME s (default 1), the pressure sampled every MPM_PILE_SAMPLE s (default 0.002), and with
+// MPM_PILE_STABILISATION = c > 0 eq. 8.6b's quasi-static stabilisation c κ/μw instead of the default dynamic
+// subscales (eq. 8.6c). Every 0.05 s it prints the water injected and removed as points (per unit width), over
+// the record's samples the worst and mean |p − p_steady| over the water
+// points inside the outline (γw H) and how many samples had a point beyond 0.1 γw H, where the record's worst
+// lay, the nodes' roughness (|p_I − the mean of its four neighbours| over full interior nodes, γw H: zero for a
+// linear field), the toe's |ṗ| (the solve's pressure at the node nearest (toe − 3h, h), between samples and
+// over the record), the water inside and outside the outline, the balance and the fastest water point. About
+// 40 s on two cores at 2 cm, 5 min on one at 1 cm:
+//   mpm_benchmark_tests --gtest_also_run_disabled_tests --gtest_filter=PileSeepage.DISABLED_CapillarySurfaceUnderACrestHead
+TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
+{
+	auto         env = [](const char* name, double fallback) { const char* v = std::getenv(name); return v ? std::atof(v) : fallback; };
+	CrestHeadRun run;
+	run.k = env("MPM_PILE_K", run.k), run.h = env("MPM_PILE_CELL", run.h), run.duration = env("MPM_PILE_TIME", run.duration);
+	run.sample = env("MPM_PILE_SAMPLE", run.sample), run.stabilisation = env("MPM_PILE_STABILISATION", 0);
+	const CrestHeadResult r = runPileUnderACrestHead(run);
+	const Discharges      q = meanDischarges(r, 0.1);
+	std::printf("over 0.1-%.2f s: in %.4e (%+.2f%% of steady), out %.4e m²/s (%+.2f%% of in)\n", run.duration, q.in, 100 * (q.in / r.inflowSteady - 1), q.out,
+	            100 * (q.out / q.in - 1));
 }
 
 } // namespace
