@@ -721,10 +721,12 @@ CrestHeadResult runPileUnderACrestHead(const CrestHeadRun& run)
 			if (!std::isfinite(toeAtRecord)) toeAtRecord = toe;
 			toeBefore = toe;
 		}
+		double volumeInside = 0, massInside = 0; // the inside points' volumes V and the mixture's volumes their masses fill, m/(n ρw) [m³]
 		for (std::size_t p = 0; p < fluid.size(); ++p) {
 			const Vec3 x = fluid.position[p];
 			stored += fluid.mass[p];
 			(x.z() >= pile.surface(x.x()) ? outside : inside) += fluid.mass[p];
+			if (x.z() < pile.surface(x.x())) volumeInside += fluid.volume[p], massInside += fluid.mass[p] / (fluid.porosity[p] * water.density);
 		}
 		const double toeRecordRate = std::abs(toeBefore - toeAtRecord) / every; // the first record's from its first sample
 		toeAtRecord = toeBefore;
@@ -738,10 +740,10 @@ CrestHeadResult runPileUnderACrestHead(const CrestHeadRun& run)
 				if (fluid.velocity[p].norm() > fluid.velocity[fastest].norm()) fastest = p;
 			std::printf("t %.2f s: in %.3e out %.3e m²/s; |p − p_steady| worst %.3f mean %.4f γw H, %d of %d samples beyond 0.1 γw H "
 			            "(worst at (%.3f, %.3f) m: %.0f Pa, steady %.0f); roughness %.3f γw H; toe |dp/dt| %.0f Pa/s between samples, %.0f over the "
-			            "record; water inside %.4e outside %.4e kg; balance %.1e; fastest water point %.3f m/s at (%.3f, %.3f) m\n",
+			            "record; water inside %.4e outside %.4e kg (inside Σ V / Σ m/(n ρw) %.4f, Σ m/(n ρw) / the outline's volume %.4f); balance %.1e; fastest water point %.3f m/s at (%.3f, %.3f) m\n",
 			            record.t, record.in, record.out, worst, mean, beyond, samples, worstAt.x(), worstAt.z(), worstP,
 			            gammaW * (reference.at(worstAt.x(), worstAt.z()) - worstAt.z()), rough / (gammaW * H), toeRate, toeRecordRate, inside, outside,
-			            result.balance, fluid.velocity[fastest].norm(), fluid.position[fastest].x(), fluid.position[fastest].z());
+			            volumeInside / massInside, massInside / (h * (pile.crest * H + 0.5 * H * H / std::tan(pile.slope))), result.balance, fluid.velocity[fastest].norm(), fluid.position[fastest].x(), fluid.position[fastest].z());
 			std::fflush(stdout);
 		}
 		injected = solver.injectedWaterMass(), removed = solver.removedWaterMass();
