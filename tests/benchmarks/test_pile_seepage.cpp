@@ -721,6 +721,24 @@ CrestHeadResult runPileUnderACrestHead(const CrestHeadRun& run)
 			if (!std::isfinite(toeAtRecord)) toeAtRecord = toe;
 			toeBefore = toe;
 		}
+		// the water points' filling Σ S V_wp / the support at nodes more than a cell inside the outline (and off the
+		// inflow face), and at the nodes of the band within a cell of the surface: where the pile's water goes
+		double fillDeep = 0, fillBand = 0;
+		int    nDeep = 0, nBand = 0;
+		if (run.print) {
+			const GridGeometry& grid = solver.grid();
+			const GridFields&   F    = solver.fields();
+			const Vec3          o    = grid.lower();
+			for (int i = 0; i < grid.nodes[0]; ++i)
+				for (int l = 0; l < grid.nodes[2]; ++l) {
+					const double      xI = o.x() + (i - grid.wallNode[0]) * h, zI = o.z() + (l - grid.wallNode[2]) * h;
+					const std::size_t I  = grid.index(i, grid.wallNode[1], l);
+					if (xI < h - 1e-9 || zI < h - 1e-9 || xI > pile.toe()) continue;
+					const double depth = pile.surface(xI) - zI, f = F.water[I].volume / grid.inDomainSupportVolume(i, grid.wallNode[1], l);
+					if (depth > h + 1e-9) fillDeep += f, ++nDeep;
+					else if (depth > -1e-9) fillBand += f, ++nBand;
+				}
+		}
 		double volumeInside = 0, massInside = 0; // the inside points' volumes V and the mixture's volumes their masses fill, m/(n ρw) [m³]
 		for (std::size_t p = 0; p < fluid.size(); ++p) {
 			const Vec3 x = fluid.position[p];
@@ -740,10 +758,11 @@ CrestHeadResult runPileUnderACrestHead(const CrestHeadRun& run)
 				if (fluid.velocity[p].norm() > fluid.velocity[fastest].norm()) fastest = p;
 			std::printf("t %.2f s: in %.3e out %.3e m²/s; |p − p_steady| worst %.3f mean %.4f γw H, %d of %d samples beyond 0.1 γw H "
 			            "(worst at (%.3f, %.3f) m: %.0f Pa, steady %.0f); roughness %.3f γw H; toe |dp/dt| %.0f Pa/s between samples, %.0f over the "
-			            "record; water inside %.4e outside %.4e kg (inside Σ V / Σ m/(n ρw) %.4f, Σ m/(n ρw) / the outline's volume %.4f); balance %.1e; fastest water point %.3f m/s at (%.3f, %.3f) m\n",
+			            "record; water inside %.4e outside %.4e kg (inside Σ V / Σ m/(n ρw) %.4f, Σ m/(n ρw) / the outline's volume %.4f; nodes' filling %.4f deep, %.4f within a cell of the surface); balance %.1e; fastest water point %.3f m/s at (%.3f, %.3f) m\n",
 			            record.t, record.in, record.out, worst, mean, beyond, samples, worstAt.x(), worstAt.z(), worstP,
 			            gammaW * (reference.at(worstAt.x(), worstAt.z()) - worstAt.z()), rough / (gammaW * H), toeRate, toeRecordRate, inside, outside,
-			            volumeInside / massInside, massInside / (h * (pile.crest * H + 0.5 * H * H / std::tan(pile.slope))), result.balance, fluid.velocity[fastest].norm(), fluid.position[fastest].x(), fluid.position[fastest].z());
+			            volumeInside / massInside, massInside / (h * (pile.crest * H + 0.5 * H * H / std::tan(pile.slope))), nDeep ? fillDeep / nDeep : 0,
+			            nBand ? fillBand / nBand : 0, result.balance, fluid.velocity[fastest].norm(), fluid.position[fastest].x(), fluid.position[fastest].z());
 			std::fflush(stdout);
 		}
 		injected = solver.injectedWaterMass(), removed = solver.removedWaterMass();
