@@ -621,6 +621,7 @@ struct CrestHeadRecord {
 struct CrestHeadResult {
 	double                       inflowSteady; // the reference's discharge [m² s⁻¹]
 	double                       balance;      // (stored + removed − initial − injected)/initial at the end
+	double                       pointWater;   // the water of one of the lattice's points [kg]
 	std::vector<CrestHeadRecord> records;
 };
 
@@ -697,7 +698,7 @@ CrestHeadResult runPileUnderACrestHead(const CrestHeadRun& run)
 	const double    perWidth  = 1 / (water.density * h * every); // kg per record → m²/s
 	double          toeBefore = NAN, toeAtRecord = NAN;           // no solve before the first step
 	double          injected = 0, removed = 0;
-	CrestHeadResult result { reference.inflow(k), 0, {} };
+	CrestHeadResult result { reference.inflow(k), 0, fluid.mass.front(), {} };
 	for (int r = 1; r * every <= run.duration + 1e-9; ++r) {
 		double worst = 0, mean = 0, worstP = 0, rough = 0, toeRate = 0, inside = 0, outside = 0, stored = 0;
 		Vec3   worstAt = Vec3::Zero();
@@ -813,8 +814,8 @@ TEST(PileSeepage, UnderACrestHeadWaterCrossesBothFacesAndThePressureIsSteadySeep
 		if (i > 0) toeRate = std::max(toeRate, r.records[i].toeRecordRate); // the first record starts from the initial table
 	}
 	const Discharges q         = meanDischarges(r, 0.1);
-	const double     window    = 0.9, h = run.h, pointWater = std::pow(h / 2, 3) * 0.4 * 1000; // [s], [m], [kg]
-	const double     oneWindow = pointWater / (1000 * h * window);                               // one point per window [m² s⁻¹]
+	const double     window = 0.9, h = run.h, rhoW = WaterParameters {}.density; // [s], [m], [kg m⁻³]
+	const double     oneWindow = r.pointWater / (rhoW * h * window);           // one point's water per window [m² s⁻¹]
 	std::printf("pile under a crest head, k = %g m/s, h = %g m: worst |p − p_steady| %.3f γw H over %zu samples (%d beyond 0.1); toe |dp/dt| %.0f Pa/s; "
 	            "over 0.1-1 s in %.4e (%+.2f%% of steady %.4e), out %.4e m²/s (%+.2f%% of in; one point %.1f%%); balance %.1e\n",
 	            run.k, h, worst, 25 * r.records.size(), beyond, toeRate, q.in, 100 * (q.in / r.inflowSteady - 1), r.inflowSteady, q.out,
