@@ -55,6 +55,7 @@ struct Domain {
 	std::vector<WaterSink> sinks;                    // water points entering one are removed
 	bool                   removeWaterLeavingGrid = true; // else a water point leaving the grid stops the run
 	bool                   removeFreeWater = false;       // remove water points that have left the soil: centre outside the skeleton, or no solid in the stencil (n = 1)
+	bool                   cutSeepageAtOutline = false;   // with removeFreeWater or still water: cut off the part of a water point beyond the skeleton's outline each step (theory.md eq. 2.4)
 };
 
 // Time-step limits of the current state (theory.md §5, eqs. 5.1–5.2), before the safety factor.

@@ -609,6 +609,8 @@ struct CapillaryPileHead {
 // summed up per record of 0.05 s.
 struct CrestHeadRun {
 	double k = 0.1, h = 0.02, duration = 1, sample = 0.002, stabilisation = 0; // [m/s], [m], [s], [s], eq. 8.6b's c (0: eq. 8.6c)
+	double stepFactor = SolverSettings {}.timeStepFactor;                       // C of the step [-]
+	bool   cutAtOutline = false;                                                // Domain::cutSeepageAtOutline (theory.md eq. 2.4)
 	bool   print = true;
 };
 struct CrestHeadRecord {
@@ -652,11 +654,13 @@ CrestHeadResult runPileUnderACrestHead(const CrestHeadRun& run)
 		fluid.porePressure[p] = std::min(pw, gammaW * (H * std::sqrt(std::max(0.0, 1 - x.x() / pile.toe())) - x.z()));
 	}
 	Domain d          = pileSlice(length, h, H);
-	d.removeFreeWater = true;
+	d.removeFreeWater     = true;
+	d.cutSeepageAtOutline = run.cutAtOutline;
 	SolverSettings s;
 	s.gravity          = Vec3(0, 0, -g);
 	s.scheme           = TimeScheme::SemiImplicit;
 	s.capillarySurface = true;
+	s.timeStepFactor   = run.stepFactor;
 	if (run.stabilisation > 0) s.darcySubscales = false, s.darcyStabilisation = run.stabilisation;
 	TwoPhaseSolver solver(d, s);
 	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
@@ -786,25 +790,28 @@ Discharges meanDischarges(const CrestHeadResult& r, double from)
 }
 
 // Issue 14's pile criterion: the sand pile under a constant head at its crest for 1 s, with water points
-// crossing both faces. At the pile's own k = 1e-3 m/s none can leave through the slope in 1 s (the seepage
-// velocity k i/n is about 1 mm/s; the header above), so the run takes k = 1e-2 m/s, a coarse sand: 2.9649e-4
-// m²/s of steady seepage (the section's finite volumes with the capillary surface's Signorini conditions at
-// 1 mm), about 13 water points of h = 2 cm through the slope in 0.9 s. The steady heads do not depend on k.
-// Asserted, every 2 ms over the whole second and at every water point inside the pile's outline: |p −
-// p_steady| < 0.1 γw H (the issue's bound; measured ≤ 0.077, mean 0.4–0.8%); the toe's pressure (the node
-// nearest (toe − 3h, h)) changes by less than 1 kPa/s over every 0.05 s record after the first (measured ≤
-// 729 Pa/s); over 0.1–1 s the inflow as new points within 4% of steady (measured −1.9%; −1.5% at h = 1 cm) and
-// the outflow, as the points the filtering cloth takes, the inflow within the points' granularity (each leaves
-// whole: one point's water, (h/2)³ n ρw = 0.4 g, is 7.6% of the 0.9 s throughflow here, and the water inside
-// the outline wanders by ±1.5 points between records; measured +7.0%, one point); the water mass balance to
-// 1e-12. What this does not show (theory.md §8 Open): the issue's 2% between inflow and outflow needs more
-// points through the face than this second carries (h = 1 cm, k = 1e-1 m/s: +2.4%), and at k = 1e-1 m/s (a
-// gravel) the field holds on average but not at every point and sample (one-step spikes where the discrete
-// conditions change).
-TEST(PileSeepage, UnderACrestHeadWaterCrossesBothFacesAndThePressureIsSteadySeepage)
+// crossing both faces. At the pile's own k = 1e-3 m/s no whole point can leave through the slope in 1 s (the
+// seepage velocity k i/n is about 1 mm/s; the header above), so the run takes k = 1e-2 m/s, a coarse sand:
+// 2.9649e-4 m²/s of steady seepage (the section's finite volumes with the capillary surface's Signorini
+// conditions at 1 mm), about 13 water points of h = 2 cm through the slope in 0.9 s. The steady heads do not
+// depend on k. Asserted, every 2 ms over the whole second and at every water point inside the pile's outline:
+// |p − p_steady| < 0.1 γw H (the issue's bound; measured ≤ 0.077, mean 0.4–0.8%); the toe's pressure (the node
+// nearest (toe − 3h, h)) changes by less than 1 kPa/s over every 0.05 s record after the first; over 0.1–1 s
+// the inflow as new points within 4% of steady and water leaving through the slope into the filtering cloth;
+// the water mass balance to 1e-12. The outflow against the inflow, in two ways:
+// - points leave whole once their centre has left the skeleton (the default): within the points'
+//   granularity — one point's water, (h/2)³ n ρw = 0.4 g, is 7.6% of the 0.9 s throughflow here and the water
+//   inside the outline wanders by ±1.5 points between records — so 2% plus one point's (measured +7.0%, one
+//   point; toe ≤ 729 Pa/s, inflow −1.9%);
+// - with `cutSeepageAtOutline` (theory.md eq. 2.4) the water leaves as slivers cut at the outline, every
+//   record: within 4% (measured +2.85%; toe ≤ 104 Pa/s, inflow −2.3%, worst 0.076).
+// Neither meets the issue's 2% (theory.md §8 Open), nor does either hold the field at every point and sample
+// at k = 1e-1 m/s (a gravel: one-step spikes where the discrete conditions change).
+class PileUnderACrestHead : public ::testing::TestWithParam<bool> {};
+TEST_P(PileUnderACrestHead, WaterCrossesBothFacesAndThePressureIsSteadySeepage)
 {
 	CrestHeadRun run;
-	run.k = 1e-2, run.h = 0.02, run.duration = 1, run.sample = 0.002, run.print = false;
+	run.k = 1e-2, run.h = 0.02, run.duration = 1, run.sample = 0.002, run.print = false, run.cutAtOutline = GetParam();
 	const CrestHeadResult r = runPileUnderACrestHead(run);
 	ASSERT_EQ(r.records.size(), 20u);
 	double worst = 0, toeRate = 0;
@@ -816,30 +823,36 @@ TEST(PileSeepage, UnderACrestHeadWaterCrossesBothFacesAndThePressureIsSteadySeep
 	const Discharges q         = meanDischarges(r, 0.1);
 	const double     window = 0.9, h = run.h, rhoW = WaterParameters {}.density; // [s], [m], [kg m⁻³]
 	const double     oneWindow = r.pointWater / (rhoW * h * window);           // one point's water per window [m² s⁻¹]
-	std::printf("pile under a crest head, k = %g m/s, h = %g m: worst |p − p_steady| %.3f γw H over %zu samples (%d beyond 0.1); toe |dp/dt| %.0f Pa/s; "
+	std::printf("pile under a crest head, k = %g m/s, h = %g m, %s: worst |p − p_steady| %.3f γw H over %zu samples (%d beyond 0.1); toe |dp/dt| %.0f Pa/s; "
 	            "over 0.1-1 s in %.4e (%+.2f%% of steady %.4e), out %.4e m²/s (%+.2f%% of in; one point %.1f%%); balance %.1e\n",
-	            run.k, h, worst, 25 * r.records.size(), beyond, toeRate, q.in, 100 * (q.in / r.inflowSteady - 1), r.inflowSteady, q.out,
-	            100 * (q.out / q.in - 1), 100 * oneWindow / q.in, r.balance);
+	            run.k, h, run.cutAtOutline ? "cut at the outline" : "whole points", worst, 25 * r.records.size(), beyond, toeRate, q.in,
+	            100 * (q.in / r.inflowSteady - 1), r.inflowSteady, q.out, 100 * (q.out / q.in - 1), 100 * oneWindow / q.in, r.balance);
 	EXPECT_EQ(beyond, 0);
 	EXPECT_LT(worst, 0.10);
 	EXPECT_LT(toeRate, 1000.0);
 	EXPECT_NEAR(q.in, r.inflowSteady, 0.04 * r.inflowSteady);
-	EXPECT_GT(q.out, 0); // water points leave through the slope into the cloth
-	EXPECT_NEAR(q.out, q.in, 0.02 * q.in + oneWindow);
+	EXPECT_GT(q.out, 0); // water leaves through the slope into the cloth
+	if (run.cutAtOutline) EXPECT_NEAR(q.out, q.in, 0.04 * q.in);
+	else EXPECT_NEAR(q.out, q.in, 0.02 * q.in + oneWindow);
 	EXPECT_LT(std::abs(r.balance), 1e-12);
 }
+INSTANTIATE_TEST_SUITE_P(PileSeepage, PileUnderACrestHead, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "cutAtOutline" : "wholePoints"; });
 
 // Not a test: the study of theory.md §8 Open, "The pile's seepage under a crest head, with its capillary
 // surface": the run above with k = MPM_PILE_K (default 0.1 m/s, gravel), h = MPM_PILE_CELL (default 0.02 m),
-// MPM_PILE_TIME s (default 1), the pressure sampled every MPM_PILE_SAMPLE s (default 0.002), and with
-// MPM_PILE_STABILISATION = c > 0 eq. 8.6b's quasi-static stabilisation c κ/μw instead of the default dynamic
-// subscales (eq. 8.6c). Every 0.05 s it prints the water injected and removed as points (per unit width), over
-// the record's samples the worst and mean |p − p_steady| over the water
-// points inside the outline (γw H) and how many samples had a point beyond 0.1 γw H, where the record's worst
-// lay, the nodes' roughness (|p_I − the mean of its four neighbours| over full interior nodes, γw H: zero for a
-// linear field), the toe's |ṗ| (the solve's pressure at the node nearest (toe − 3h, h), between samples and
-// over the record), the water inside and outside the outline, the balance and the fastest water point. About
-// 40 s on two cores at 2 cm, 5 min on one at 1 cm:
+// MPM_PILE_TIME s (default 1), the pressure sampled every MPM_PILE_SAMPLE s (default 0.002), the step's
+// timeStepFactor MPM_PILE_STEP_FACTOR (default the solver's), MPM_PILE_CUT = 1 for cutSeepageAtOutline, and
+// with MPM_PILE_STABILISATION = c > 0 eq. 8.6b's quasi-static stabilisation c κ/μw instead of the default
+// dynamic subscales (eq. 8.6c). Every 0.05 s it prints
+// the water injected and removed as points (per unit width), over the record's samples the worst and mean
+// |p − p_steady| over the water points inside the outline (γw H) and how many samples had a point beyond
+// 0.1 γw H, where the record's worst lay, the nodes' roughness (|p_I − the mean of its four neighbours| over
+// full interior nodes, γw H: zero for a linear field), the toe's |ṗ| (the solve's pressure at the node nearest
+// (toe − 3h, h), between samples and over the record), the water inside and outside the outline with the
+// inside points' volumes against the mixture their water fills and the nodes' filling deep inside and along
+// the surface, the balance and the fastest water point; at the end the mean discharges from 0.1 s on and the
+// stored water's least-squares slope. About 40 s on two cores at 2 cm, 5 min on one at 1 cm:
 //   mpm_benchmark_tests --gtest_also_run_disabled_tests --gtest_filter=PileSeepage.DISABLED_CapillarySurfaceUnderACrestHead
 TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
 {
@@ -847,6 +860,7 @@ TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
 	CrestHeadRun run;
 	run.k = env("MPM_PILE_K", run.k), run.h = env("MPM_PILE_CELL", run.h), run.duration = env("MPM_PILE_TIME", run.duration);
 	run.sample = env("MPM_PILE_SAMPLE", run.sample), run.stabilisation = env("MPM_PILE_STABILISATION", 0);
+	run.stepFactor = env("MPM_PILE_STEP_FACTOR", run.stepFactor), run.cutAtOutline = env("MPM_PILE_CUT", 0) != 0;
 	const CrestHeadResult r = runPileUnderACrestHead(run);
 	const Discharges      q = meanDischarges(r, 0.1);
 	// the stored water's least-squares slope over the same records: in − out = its rate exactly (the balance), and

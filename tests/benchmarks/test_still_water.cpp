@@ -33,7 +33,7 @@ struct SubmergedColumn {
 	// fixed impermeable base); the soil's top is its own free surface, two cells below the domain's top
 	double          height;
 
-	explicit SubmergedColumn(double excessHead, double soilHeight = H, bool inflow = false, double conductivity = k)
+	explicit SubmergedColumn(double excessHead, double soilHeight = H, bool inflow = false, double conductivity = k, bool cut = false)
 	        : height(soilHeight)
 	{
 		soil.porosity              = 0.4;
@@ -53,6 +53,7 @@ struct SubmergedColumn {
 		if (excessHead > 0) fixtures::reservoirFace(d, Face::ZMin, height + waterAboveSoil + excessHead, inflow, SolidWall::Fixed);
 		d.boundaries.stillWaterLevel = height + waterAboveSoil;
 		d.removeFreeWater            = true; // seepage that leaves the soil's top joins the still water
+		d.cutSeepageAtOutline        = cut;
 		SolverSettings s;
 		s.gravity = Vec3(0, 0, -g);
 		solver    = std::make_unique<TwoPhaseSolver>(d, s);
@@ -180,6 +181,55 @@ TEST(StillWater, SeepageEntersAtTheBaseAndLeavesThroughTheSubmergedSurfaceAsPoin
 	EXPECT_LT(std::abs(balance), 1e-12);
 }
 
+// The same with `cutSeepageAtOutline`: the water leaves the soil's submerged top as it crosses the
+// skeleton's outline — the part of a point's domain beyond the outline is cut off each step (eq. 2.4) —
+// so the outflow is as continuous as the inflow. Both are Darcy's flux k i ρw A over each of three 0.5 s
+// windows once the column is steady (from 1.5 s), within 2% as Charny's dam is held (measured in
+// −0.2…−0.05%, out −1.8…+1.7%); and not in bursts: no step removes more than a quarter of one
+// point's water (measured 0.096: a last sliver whose centre crossed leaves whole). Without the cut
+// (the test above) a layer's four points leave within a few steps every 1.27 s, and the rates can only
+// be taken over whole layers. The water's mass balances to round-off.
+TEST(StillWater, SeepageEntersAtTheBaseAndLeavesThroughTheSubmergedSurfaceContinuously)
+{
+	const double    gammaW = WaterParameters {}.density * g, conductivity = 0.01;
+	SubmergedColumn probe(0);
+	const double    i = 0.8 * probe.buoyantUnitWeight() / gammaW;
+	const double    height = H / 2;
+	SubmergedColumn c(i * height, height, true, conductivity, true);
+	auto            stored = [&] {
+                double m = 0;
+                for (double mp : c.fluid.mass) m += mp;
+                return m;
+	};
+	const double initial = stored(), point = c.fluid.mass.front();
+	const double dt      = 0.5 * c.solver->timeStepLimits().critical;
+	const double darcy   = conductivity * i * c.water.density * h * h; // [kg s⁻¹]
+	const double start = 1.5, window = 0.5;
+	double       t = 0, largestStep = 0, windowStart = 0, removedAt = 0, injectedAt = 0;
+	int          windows = 0;
+	while (windows < 3) {
+		const double removedBefore = c.solver->removedWaterMass();
+		c.solver->step(dt);
+		t += dt;
+		if (t > start) largestStep = std::max(largestStep, c.solver->removedWaterMass() - removedBefore);
+		if (t >= start && windowStart == 0) windowStart = t, removedAt = c.solver->removedWaterMass(), injectedAt = c.solver->injectedWaterMass();
+		if (windowStart > 0 && t >= windowStart + window) {
+			const double span = t - windowStart;
+			const double out = (c.solver->removedWaterMass() - removedAt) / span, in = (c.solver->injectedWaterMass() - injectedAt) / span;
+			std::printf("seepage through the submerged surface, %.2f … %.2f s: in %+.4f, out %+.4f of Darcy's %.4e kg/s\n", windowStart, t, in / darcy - 1,
+			            out / darcy - 1, darcy);
+			EXPECT_NEAR(in / darcy, 1, 0.02);
+			EXPECT_NEAR(out / darcy, 1, 0.02);
+			windowStart = t, removedAt = c.solver->removedWaterMass(), injectedAt = c.solver->injectedWaterMass();
+			++windows;
+		}
+	}
+	const double balance = (stored() + c.solver->removedWaterMass() - initial - c.solver->injectedWaterMass()) / initial;
+	std::printf("largest removal in one step %.2e of a point's water; balance %.1e\n", largestStep / point, balance);
+	EXPECT_LT(largestStep, 0.25 * point);
+	EXPECT_LT(std::abs(balance), 1e-12);
+}
+
 // Input checks (before any work): a level that is not a finite elevation, and soil (solid points)
 // above the level.
 TEST(StillWater, RefusesALevelBelowTheSoilAndANonFiniteOne)
@@ -209,9 +259,14 @@ TEST(StillWater, RefusesALevelBelowTheSoilAndANonFiniteOne)
 // base, whose tip is one point thick and one long. The skeleton's nodal filling at the tip's water
 // points reads 0.435 (the nodes there see one point's volume over their whole support), below ½;
 // without the containment test (their centres lie in a solid point's domain) those 2 of the 20
-// water points left at the first step (checked). At rest under still water nothing may leave.
-TEST(StillWater, AOnePointThickEdgeOfTheSkeletonKeepsItsWater)
+// water points left at the first step (checked). At rest under still water no point may leave, and
+// nothing at all without `cutSeepageAtOutline`; what the outline's cut takes (eq. 2.4) is the wedge's
+// elastic settlement against its water over the 200 steps (|v_s| 1.4e-5 m/s), measured 3.1e-5 of one
+// point's water, held below 1e-4 of it.
+class EdgeOfTheSkeleton : public ::testing::TestWithParam<bool> {};
+TEST_P(EdgeOfTheSkeleton, AOnePointThickEdgeOfTheSkeletonKeepsItsWater)
 {
+	const bool      cut = GetParam();
 	SoilParameters  soil;
 	WaterParameters water;
 	soil.porosity              = 0.4;
@@ -231,19 +286,24 @@ TEST(StillWater, AOnePointThickEdgeOfTheSkeletonKeepsItsWater)
 	d.boundaries.walls[static_cast<int>(Face::ZMax)] = { SolidWall::Free, WaterWall::Free };
 	d.boundaries.stillWaterLevel = 3 * h;
 	d.removeFreeWater            = true;
+	d.cutSeepageAtOutline        = cut;
 	SolverSettings s;
 	s.gravity = Vec3(0, 0, -g);
 	TwoPhaseSolver solver(d, s);
 	solver.setPoints({ SolidSet { &solid, soil } }, { &fluid }, water);
 	const std::size_t points = fluid.size();
-	const double      dt     = 0.5 * solver.timeStepLimits().critical;
+	const double      point  = fluid.mass.front(), dt = 0.5 * solver.timeStepLimits().critical; // one point's water [kg]
 	for (int i = 0; i < 200; ++i) solver.step(dt);
 	double vMax = 0;
 	for (const Vec3& v : solid.velocity) vMax = std::max(vMax, v.norm());
-	std::printf("one-point-thick edge: %zu of %zu water points kept, removed %.3e kg, max |v_s| %.2e m/s\n", fluid.size(), points, solver.removedWaterMass(), vMax);
+	std::printf("one-point-thick edge: %zu of %zu water points kept, removed %.3e kg (%.1e of a point's), max |v_s| %.2e m/s\n", fluid.size(), points,
+	            solver.removedWaterMass(), solver.removedWaterMass() / point, vMax);
 	EXPECT_EQ(fluid.size(), points);
-	EXPECT_EQ(solver.removedWaterMass(), 0.0);
+	if (cut) EXPECT_LT(solver.removedWaterMass(), 1e-4 * point);
+	else EXPECT_EQ(solver.removedWaterMass(), 0.0);
 	EXPECT_LT(vMax, 1e-4); // settled: the wedge's elastic adjustment to its buoyant weight (measured 1.4e-5 m/s after 200 steps)
 }
+INSTANTIATE_TEST_SUITE_P(StillWater, EdgeOfTheSkeleton, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "cutAtOutline" : "wholePoints"; });
 
 } // namespace
