@@ -139,6 +139,8 @@ parser.add_argument("--darcy-subscales", action=argparse.BooleanOptionalAction, 
 parser.add_argument("--darcy-stabilisation", type=float, metavar="C",
                     help="the engine's darcyStabilisation C, 0 ≤ C ≤ 10: that stabilisation's quasi-static form with weight C "
                          "(theory.md eq. 8.6b; needs --no-darcy-subscales; default the engine's, 0)")
+parser.add_argument("--cut-seepage-at-outline", action="store_true",
+                    help="cut the seeped water at the skeleton's outline each step instead of a point at a time (cutSeepageAtOutline, theory.md eq. 2.4; off by default)")
 parser.add_argument("--points-per-cell", type=int, default=2, metavar="N", help="points per cell and axis of each phase (default 2)")
 parser.add_argument("--shape-function", choices=("linear", "uGIMP", "cpGIMP"), default="uGIMP", help="the engine's shape functions (default uGIMP)")
 parser.add_argument("--sand-from-dem", metavar="DIR",
@@ -289,6 +291,7 @@ engine = MpmTwoPhaseEngine(
     freeSurfaceHoldsSuction=not SEMI_IMPLICIT,  # ... held by capillarity above the phreatic line, a seepage face below it
     capillarySurface=args.capillary_surface,    # the same on the semi-implicit step (theory.md eq. 8.5e)
     removeFreeWater=True,       # the filtering cloth
+    cutSeepageAtOutline=args.cut_seepage_at_outline,
     **({} if args.time_step_factor is None else dict(timeStepFactor=args.time_step_factor)),  # the engine refuses C outside (0, 1/√2] (semi-implicit, GIMP: theory.md eq. 8.10b)
     **({} if args.flip_blend is None else dict(flipBlend=args.flip_blend)),  # and B outside [0, 1]
     **({} if args.darcy_stabilisation is None else dict(darcyStabilisation=args.darcy_stabilisation)),  # and C outside [0, 10]
@@ -544,6 +547,7 @@ summary = {
     "flip_blend": engine.flipBlend,
     "darcy_stabilisation": engine.darcyStabilisation,
     "darcy_subscales": engine.darcySubscales,
+    "cut_seepage_at_outline": engine.cutSeepageAtOutline,
     "shape_function": args.shape_function,
     "capillary_surface": args.capillary_surface,
     "solid_points": int(solid.count),
