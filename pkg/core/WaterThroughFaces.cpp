@@ -92,13 +92,14 @@ void TwoPhaseSolver::removeOutflowingWater()
 	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid && !domain_.removeFreeWater && !drainedFace && !domain_.boundaries.submerged()) return;
 	const Vec3 faceLower = grid_.lower(), faceUpper = grid_.upper();
 	skeletonBins_.clear(); // the solid points have moved; injectInflowingWater, next, reuses the bins
-	// within an inflow face's rows (eq. 2.5): the reservoir's water, not seepage out of the soil
-	auto nearInflowRows = [&](const WaterPointSet& w, std::size_t p) {
+	// within an inflow face's rows (eq. 2.5, whose band is in the set's regular spacing, the one its rows
+	// tile; a buffer is thinner) or its cell: the reservoir's water, not seepage out of the soil
+	auto nearInflowRows = [&](const Vec3& x, const Vec3& regularHalfLength) {
 		for (int f = 0; f < faceCount; ++f) {
 			if (!domain_.boundaries.walls[f].inflow) continue;
 			const int  d     = f / 2;
-			const Real depth = f % 2 ? faceUpper[d] - w.position[p][d] : w.position[p][d] - faceLower[d];
-			if (depth < std::max<Real>(inflowRowBand * 2 * w.halfLength[p][d], grid_.cellSize)) return true;
+			const Real depth = f % 2 ? faceUpper[d] - x[d] : x[d] - faceLower[d];
+			if (depth < std::max<Real>(inflowRowBand * 2 * regularHalfLength[d], grid_.cellSize)) return true;
 		}
 		return false;
 	};
@@ -141,7 +142,8 @@ void TwoPhaseSolver::removeOutflowingWater()
 		w.halfLength[p][axis] = 0.5 * inside;
 		w.position[p][axis]   = x[axis] - side * l[axis] + side * 0.5 * inside; // the inner end stays
 	};
-	for (WaterPointSet* w : waters_) {
+	for (std::size_t set = 0; set < waters_.size(); ++set) {
+		WaterPointSet*    w = waters_[set];
 		const std::size_t n = w->size();
 		removeFlags_.assign(n, 0);
 		bool any = false;
@@ -177,7 +179,8 @@ void TwoPhaseSolver::removeOutflowingWater()
 				w->halfLength[p][d] = 0.5 * inside;
 				w->position[p][d]   = plane + inward * 0.5 * inside;
 			}
-			if (!out && domain_.cutSeepageAtOutline && (domain_.removeFreeWater || domain_.boundaries.submerged()) && !nearInflowRows(*w, p))
+			if (!out && domain_.cutSeepageAtOutline && (domain_.removeFreeWater || domain_.boundaries.submerged()) &&
+			    !nearInflowRows(w->position[p], regularHalfLength_[set]))
 				trimAtSkeletonOutline(*w, p);
 			if (!out && domain_.removeWaterLeavingGrid)
 				for (int d = 0; d < 3; ++d) { // the widest (GIMP) stencil must fit in the grid
