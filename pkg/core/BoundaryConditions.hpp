@@ -51,6 +51,14 @@ struct WallConditions {
 		return g == 0 || waterTable == -std::numeric_limits<Real>::infinity() || -gravity.dot(x) / g < waterTable;
 	}
 
+	// Whether x lies above the water table by more than `tolerance` [m] (never without a table or without
+	// gravity): a point within it of the table lies on it.
+	bool aboveWaterTable(const Vec3& x, const Vec3& gravity, Real tolerance) const
+	{
+		const Real g = gravity.norm();
+		return g > 0 && waterTable > -std::numeric_limits<Real>::infinity() && -gravity.dot(x) / g > waterTable + tolerance;
+	}
+
 	// p̄ at position x (theory.md eq. 2.1); with a still water level (eq. 1.9, finite
 	// `stillWaterLevel`) the excess over that water's hydrostatic pressure ρw |g| (level − z)
 	Real drainedPressureAt(const Vec3& x, const Vec3& gravity, Real waterDensity, Real stillWaterLevel) const

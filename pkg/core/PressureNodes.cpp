@@ -18,6 +18,9 @@ namespace stages {
 	// to the water's compression and the points' spread).
 	constexpr Real tubeFullShare  = 15.0 / 16;
 	constexpr Real tubeEmptyShare = 1.0 / 16;
+	// A drained face's node within this share of a cell of the face's table lies on it (eq. 8.5g): node
+	// positions are origin + i h, so a table set at a node's level differs from it by round-off.
+	constexpr Real nodeOnTable = 1e-9;
 
 	// Eq. 8.5d: the water points' volume in each node's cell [x_I − h/2, x_I + h/2]³, each point's
 	// state volume m/(n ρw) shared by its domain's overlap with the cells (at most two per axis: l_p ≤ h/2).
@@ -254,8 +257,10 @@ namespace stages {
 						const Vec3 x = grid.nodePosition(idx[0], idx[1], idx[2]);
 						drained      = true;
 						value        = wall.drainedPressureAt(x, gravity, waterDensity, bcs.stillWaterLevel);
-						// p̄ = 0 above the face's table is the air over a reservoir, not water (eq. 8.5g)
-						aboveTables = aboveTables && !wall.belowWaterTable(x, gravity) && wall.drainedPressure == 0 && !std::isfinite(bcs.stillWaterLevel);
+						// p̄ = 0 above the face's table is the air over a reservoir, not water (eq. 8.5g); a node on
+						// the table is the reservoir's surface, whose water wets its support's lower half
+						aboveTables = aboveTables && wall.aboveWaterTable(x, gravity, nodeOnTable * grid.cellSize) && wall.drainedPressure == 0 &&
+						              !std::isfinite(bcs.stillWaterLevel);
 					} else if (wall.water == WaterWall::Free) open = true;
 				}
 			}

@@ -795,20 +795,23 @@ Discharges meanDischarges(const CrestHeadResult& r, double from)
 // 2.9649e-4 m²/s of steady seepage (the section's finite volumes with the capillary surface's Signorini
 // conditions at 1 mm), about 13 water points of h = 2 cm through the slope in 0.9 s. The steady heads do not
 // depend on k. Asserted, every 2 ms over the whole second and at every water point inside the pile's outline:
-// |p − p_steady| < 0.1 γw H (the bound; measured ≤ 0.077, mean 0.4–0.8%); the toe's pressure (the node
-// nearest (toe − 3h, h)) changes by less than 1 kPa/s over every 0.05 s record after the first; over 0.1–1 s
-// the inflow as new points within 4% of steady and water leaving through the slope into the filtering cloth;
-// the water mass balance to 1e-12. The outflow against the inflow, in two ways:
+// |p − p_steady| < 0.1 γw H (the bound; measured ≤ 0.083 in the first record, from the initial table,
+// 0.011–0.034 after); the toe's pressure (the node nearest (toe − 3h, h)) changes by less than 1 kPa/s over every
+// 0.05 s record after the first; over 0.1–1 s the inflow as new points within 2% of steady (measured −0.2% and
+// −0.6%; −1.9% and −2.3% while the face's node on its table, the crest's corner, was held as air: theory.md
+// eq. 8.5g) and water leaving through the slope into the filtering cloth; the water mass balance to 1e-12. The
+// outflow against the inflow, in two ways:
 // - points leave whole once their centre has left the skeleton (the default): within the points'
-//   granularity — one point's water, (h/2)³ n ρw = 0.4 g, is 7.6% of the 0.9 s throughflow here and the water
-//   inside the outline wanders by ±1.5 points between records — so 2% plus one point's (measured +7.0%, one
-//   point; toe ≤ 729 Pa/s, inflow −1.9%);
+//   granularity — one point's water, (h/2)³ n ρw = 0.4 g, is 7.5% of the 0.9 s throughflow here and the water
+//   inside the outline wanders by ±1.5 points between records — so 2% plus one point's (measured +5.15%;
+//   toe ≤ 766 Pa/s);
 // - with `cutSeepageAtOutline` (theory.md eq. 2.4) the water leaves as slivers cut at the outline, every
-//   record: within 4% (measured +2.85%; toe ≤ 104 Pa/s, inflow −2.3%, worst 0.076; at half the step,
-//   timeStepFactor 0.25, +5.2%, toe ≤ 98 Pa/s, worst 0.082 — the balance is not yet independent of Δt;
-//   whole points there: +7.0%, one sample beyond 0.1 γw H (0.137), toe ≤ 781 Pa/s).
-// Neither meets the 2% (theory.md §8 Open), nor does either hold the field at every point and sample
-// at k = 1e-1 m/s (a gravel: one-step spikes where the discrete conditions change).
+//   record, and in pieces of a quarter to a third of a point where a point passes a step of the solid
+//   domains' staircase: within 4%, 2% and such a piece (measured +1.82%, toe ≤ 100 Pa/s; at timeStepFactor
+//   0.35 and 0.25 +4.1% and +4.0%, where the pieces fall in the window; at h = 1 cm +0.88%).
+// The 2% holds here with the cut at this step and at h = 1 cm, not yet at every step at 2 cm
+// (theory.md §8 Open); neither setting holds the field at every point and sample at k = 1e-1 m/s (a gravel:
+// one-step spikes where the discrete conditions change).
 class PileUnderACrestHead : public ::testing::TestWithParam<bool> {};
 TEST_P(PileUnderACrestHead, WaterCrossesBothFacesAndThePressureIsSteadySeepage)
 {
@@ -832,7 +835,7 @@ TEST_P(PileUnderACrestHead, WaterCrossesBothFacesAndThePressureIsSteadySeepage)
 	EXPECT_EQ(beyond, 0);
 	EXPECT_LT(worst, 0.10);
 	EXPECT_LT(toeRate, 1000.0);
-	EXPECT_NEAR(q.in, r.inflowSteady, 0.04 * r.inflowSteady);
+	EXPECT_NEAR(q.in, r.inflowSteady, 0.02 * r.inflowSteady);
 	EXPECT_GT(q.out, 0); // water leaves through the slope into the cloth
 	if (run.cutAtOutline) EXPECT_NEAR(q.out, q.in, 0.04 * q.in);
 	else EXPECT_NEAR(q.out, q.in, 0.02 * q.in + oneWindow);
