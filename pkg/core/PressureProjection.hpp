@@ -99,10 +99,6 @@ struct PressureSystem {
 	std::vector<PressureForceNode>              forces;
 	std::vector<std::vector<PressureForceNode>> forceBuffers;
 	Eigen::SparseMatrix<Real, Eigen::RowMajor> matrix;
-	struct FreePair {
-		int  row, column; // unknowns of an upper-half pair of K
-		Real value;
-	};
 	struct NodePair {
 		std::size_t row, column; // pressure nodes (row ≤ column: one entry stands for K_rc and K_cr)
 		Real        value;       // [m³ s⁻¹ Pa⁻¹]
@@ -120,9 +116,10 @@ struct PressureSystem {
 	std::vector<std::vector<Real>>                pairBlocks;       // (same), per thread: per row they reach, its pairs by offset (365 slots: (−4…4)³ after the row's node); zero between steps
 	std::vector<std::vector<int>>                 pairBlockOf;      // (same), per thread: per row, its block in pairBlocks, −1: none
 	std::vector<std::vector<NodePair>>            emittedPairs;     // (same), per thread: the pairs of its share of the rows
-	std::vector<FreePair> pairScratch;                              // buildPressureMatrix's scratch, kept from step to step
-	std::vector<int>      rowCount, cursorScratch, columnScratch; // (same)
+	std::vector<int>      rowCount, cursorScratch, columnScratch; // buildPressureMatrix's scratch, kept from step to step
 	std::vector<Real>     valueScratch;                           // (same)
+	std::vector<int>      memberStart, members;                   // (same): per unknown, the pressure nodes it stands for (its own, those tied to it)
+	std::vector<int>      extraRowStart, extraColumnStart, extraByColumn; // (same): per pressure node, its extra pairs as the row and as the column
 	Eigen::Matrix<Real, Eigen::Dynamic, 1>     rhs, solution, previousSolution;
 	std::vector<std::size_t>                   previousNode; // grid node of each entry of previousSolution (warm start)
 	Real                                       meanDiagonal = 0; // mean K_JJ of the free rows [m³ s⁻¹ Pa⁻¹]

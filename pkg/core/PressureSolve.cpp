@@ -54,10 +54,13 @@ namespace stages {
 		// CSR of the free rows, the prescribed columns moved to the right-hand side. Each stored pair
 		// (r, J) of the upper half gives K_rJ to row r and K_Jr = K_rJ to row J. A surface node tied to
 		// a free one (eq. 8.5b, p_r = c p_m) is eliminated: p = T p̂, K̂ = TᵀKT, b̂ = Tᵀb, so its row and
-		// column join its master's with the factor c (symmetric, positive definite as K). Rows are visited
-		// in grid order, so row u mostly receives its lower entries (from earlier rows) and then its own
-		// upper ones in column order; a tied node, a periodic axis that wrapped or, on one of 3 cells, two
-		// offsets reaching the same node break the order: such rows are sorted and merged afterwards.
+		// column join its master's with the factor c (symmetric, positive definite as K). Each free row
+		// gathers its own entries, so the rows are built in parallel without a race: from each node it
+		// stands for (its own and those tied to it), the 125 offsets of the stencil in grid order — the
+		// upper ones from the node's stored row, the lower ones from the neighbour's, where K_Jr is
+		// stored — with the extra pairs merged in by node. A node's row thus comes in column order; a
+		// tied node, a periodic axis that wrapped or, on one of 3 cells, two offsets reaching the same
+		// node break the order: such rows are sorted and merged afterwards.
 		system.tiedUnknown.assign(active, -1);
 		system.tiedWeight.assign(active, 1);
 		for (std::size_t r = 0; r < active; ++r) {
@@ -67,94 +70,121 @@ namespace stages {
 		}
 		const std::vector<int>&  unknownOf = system.tiedUnknown;
 		const std::vector<Real>& weightOf  = system.tiedWeight;
-		using Pair                         = PressureSystem::FreePair;
-		std::vector<Pair>& pairs           = system.pairScratch;
-		pairs.clear();
-		for (int u = 0; u < n; ++u) system.rhs[u] = 0;
-		for (std::size_t r = 0; r < active; ++r)
-			if (unknownOf[r] >= 0) system.rhs[unknownOf[r]] += weightOf[r] * system.rows[r * PressureSystem::rowStride + PressureSystem::rhsSlot];
-		std::vector<int>& count = system.rowCount;
-		count.assign(n + 1, 0);
-		auto add = [&](int row, int column, Real value) {
-			pairs.push_back(Pair { row, column, value });
-			++count[row + 1];
-			if (column != row) ++count[column + 1];
-		};
-		// the pair (r, J) of K with its value (stored row or extra pair): into the free rows, or onto the
-		// right-hand side where one end is prescribed
-		auto addPair = [&](std::size_t r, std::size_t J, Real value) {
-			const int ur = unknownOf[r], uJ = unknownOf[J];
-			if (r == J) {
-				if (ur >= 0) add(ur, ur, weightOf[r] * weightOf[r] * value);
-			} else if (ur >= 0 && uJ >= 0) {
-				const Real tied = weightOf[r] * weightOf[J] * value;
-				if (ur == uJ) add(ur, ur, 2 * tied); // a tied node and its master: K_rJ and K_Jr both land on the diagonal
-				else add(ur, uJ, tied);
-			} else if (ur >= 0) system.rhs[ur] -= weightOf[r] * value * system.fixedValue[J];
-			else if (uJ >= 0) system.rhs[uJ] -= weightOf[J] * value * system.fixedValue[r];
-		};
-		// the extra pairs by (row, column), as meniscusPairs emits them: row r's join its stored ones in
-		// column order, a column both hold as one entry, so that the rows stay in order without a sort
+		// the extra pairs by (row, column), as meniscusPairs emits them; each stands for K_rc and K_cr,
+		// so a node finds its own as the row (extraRowStart) and as the column (extraByColumn, in row order)
 		std::vector<PressureSystem::NodePair>& extra = system.extraPairs;
 		auto byRowThenColumn = [](const PressureSystem::NodePair& x, const PressureSystem::NodePair& y) { return x.row < y.row || (x.row == y.row && x.column < y.column); };
 		if (!std::is_sorted(extra.begin(), extra.end(), byRowThenColumn)) std::sort(extra.begin(), extra.end(), byRowThenColumn);
-		std::size_t next = 0;
-		for (std::size_t r = 0; r < active; ++r) {
-			// a row held at p = 0 and tied to no unknown adds exactly zero through each of its pairs
-			if (unknownOf[r] < 0 && system.fixedValue[r] == 0) {
-				while (next < extra.size() && extra[next].row == r) ++next;
-				continue;
-			}
-			const Real*              k   = system.rows.data() + r * PressureSystem::rowStride;
-			const std::array<int, 3> idx = grid.indices(system.node[r]);
-			for (int o = centreSlot; o < PressureSystem::offsets; ++o) {
-				Real value = k[o - centreSlot];
-				if (value == 0) continue; // a non-zero coefficient joins two nodes of one stencil: both on the grid
-				const int         a = o % 5 - 2, b = (o / 5) % 5 - 2, c = o / 25 - 2;
-				const std::size_t J = static_cast<std::size_t>(system.row[grid.index(grid.wrap(0, idx[0] + a), grid.wrap(1, idx[1] + b), grid.wrap(2, idx[2] + c))]);
-				for (; next < extra.size() && extra[next].row == r && extra[next].column < J; ++next) addPair(r, extra[next].column, extra[next].value);
-				if (next < extra.size() && extra[next].row == r && extra[next].column == J) value += extra[next++].value;
-				addPair(r, J, value);
-			}
-			for (; next < extra.size() && extra[next].row == r; ++next) addPair(r, extra[next].column, extra[next].value);
+		std::vector<int>& rowStart = system.extraRowStart;
+		std::vector<int>& columnStart = system.extraColumnStart;
+		std::vector<int>& byColumn    = system.extraByColumn;
+		rowStart.assign(active + 1, 0);
+		columnStart.assign(active + 1, 0);
+		for (const PressureSystem::NodePair& e : extra) {
+			++rowStart[e.row + 1];
+			if (e.column != e.row) ++columnStart[e.column + 1];
 		}
-		for (int i = 0; i < n; ++i) count[i + 1] += count[i];
+		for (std::size_t r = 0; r < active; ++r) rowStart[r + 1] += rowStart[r], columnStart[r + 1] += columnStart[r];
+		byColumn.resize(static_cast<std::size_t>(columnStart[active]));
+		{
+			std::vector<int>& cursor = system.cursorScratch;
+			cursor.assign(columnStart.begin(), columnStart.end() - 1);
+			for (std::size_t e = 0; e < extra.size(); ++e)
+				if (extra[e].column != extra[e].row) byColumn[static_cast<std::size_t>(cursor[extra[e].column]++)] = static_cast<int>(e);
+		}
+		// the nodes each unknown stands for, in row order
+		std::vector<int>& memberStart = system.memberStart;
+		std::vector<int>& members     = system.members;
+		memberStart.assign(n + 1, 0);
+		for (std::size_t r = 0; r < active; ++r)
+			if (unknownOf[r] >= 0) ++memberStart[unknownOf[r] + 1];
+		for (int u = 0; u < n; ++u) memberStart[u + 1] += memberStart[u];
+		members.resize(static_cast<std::size_t>(memberStart[n]));
+		{
+			std::vector<int>& cursor = system.cursorScratch;
+			cursor.assign(memberStart.begin(), memberStart.end() - 1);
+			for (std::size_t r = 0; r < active; ++r)
+				if (unknownOf[r] >= 0) members[static_cast<std::size_t>(cursor[unknownOf[r]]++)] = static_cast<int>(r);
+		}
+		// room per free row: every offset and extra pair of its nodes
+		std::vector<int>& count = system.rowCount;
+		count.assign(n + 1, 0);
+		for (int u = 0; u < n; ++u) {
+			int room = 0;
+			for (int m = memberStart[u]; m < memberStart[u + 1]; ++m) {
+				const int r = members[m];
+				room += PressureSystem::offsets + (rowStart[r + 1] - rowStart[r]) + (columnStart[r + 1] - columnStart[r]);
+			}
+			count[u + 1] = count[u] + room;
+		}
 		std::vector<int>&  column = system.columnScratch;
 		std::vector<Real>& value  = system.valueScratch;
 		resizeKeepingStorage(column, static_cast<std::size_t>(count[n]));
 		resizeKeepingStorage(value, static_cast<std::size_t>(count[n]));
-		std::vector<int>& cursor = system.cursorScratch;
-		cursor.assign(count.begin(), count.end() - 1);
-		for (const Pair& e : pairs) {
-			column[cursor[e.row]] = e.column, value[cursor[e.row]++] = e.value;
-			if (e.column != e.row) column[cursor[e.column]] = e.row, value[cursor[e.column]++] = e.value;
-		}
-		// sort and merge in place the rows out of order (a tied node's, a wrapped periodic axis's); `merged`
-		// keeps the new lengths. Such a row is a few runs in order: an insertion sort (stable, so equal
-		// columns are summed in the order they came) moves only the entries out of place
-		std::vector<int>& merged = system.cursorScratch;
+		std::vector<int>& merged = system.cursorScratch; // per free row: its entries once sorted and merged
+		merged.assign(n, 0);
+		system.rhs.resize(n);
+		const Real* rows = system.rows.data();
 #pragma omp parallel for schedule(static) if(n > static_cast<int>(parallelThreshold))
 		for (int u = 0; u < n; ++u) {
-			const int first = count[u], last = count[u + 1];
+			const int first = count[u];
+			int       e     = first;
+			Real      b     = 0;
+			// K_rJ of node r (one of u's): into the row, or onto the right-hand side where J is prescribed
+			// (a node held at p = 0 and tied to no unknown adds exactly zero)
+			auto add = [&](std::size_t r, std::size_t J, Real k) {
+				const int uJ = unknownOf[J];
+				if (J == r) column[e] = u, value[e++] = weightOf[r] * weightOf[r] * k;
+				else if (uJ >= 0) column[e] = uJ, value[e++] = weightOf[r] * weightOf[J] * k;
+				else if (system.fixedValue[J] != 0) b -= weightOf[r] * k * system.fixedValue[J];
+			};
+			for (int m = memberStart[u]; m < memberStart[u + 1]; ++m) {
+				const std::size_t        r   = static_cast<std::size_t>(members[m]);
+				const Real*              k   = rows + r * PressureSystem::rowStride;
+				const std::array<int, 3> idx = grid.indices(system.node[r]);
+				b += weightOf[r] * k[PressureSystem::rhsSlot];
+				int asColumn = columnStart[r], asRow = rowStart[r]; // the next extra pair of each kind
+				auto extrasBefore = [&](std::size_t J) { // the extra pairs with a node before J (or at it)
+					for (; asColumn < columnStart[r + 1] && extra[static_cast<std::size_t>(byColumn[asColumn])].row <= J; ++asColumn) {
+						const PressureSystem::NodePair& x = extra[static_cast<std::size_t>(byColumn[asColumn])];
+						add(r, x.row, x.value);
+					}
+					for (; asRow < rowStart[r + 1] && extra[static_cast<std::size_t>(asRow)].column <= J; ++asRow) add(r, extra[asRow].column, extra[asRow].value);
+				};
+				for (int o = 0; o < PressureSystem::offsets; ++o) {
+					const int at[3] = { grid.wrap(0, idx[0] + o % 5 - 2), grid.wrap(1, idx[1] + (o / 5) % 5 - 2), grid.wrap(2, idx[2] + o / 25 - 2) };
+					if (at[0] < 0 || at[1] < 0 || at[2] < 0 || at[0] >= grid.nodes[0] || at[1] >= grid.nodes[1] || at[2] >= grid.nodes[2]) continue;
+					const int J = system.row[grid.index(at[0], at[1], at[2])];
+					if (J < 0) continue;
+					// K_rJ: stored in r's row for an offset ≥ 0, in J's for the opposite offset otherwise
+					const Real kJ = o >= centreSlot ? k[o - centreSlot] : rows[static_cast<std::size_t>(J) * PressureSystem::rowStride + (PressureSystem::offsets - 1 - o) - centreSlot];
+					if (kJ == 0) continue; // no point joins them
+					extrasBefore(static_cast<std::size_t>(J));
+					add(r, static_cast<std::size_t>(J), kJ);
+				}
+				extrasBefore(active);
+			}
+			system.rhs[u] = b;
+			// sort and merge in place a row out of order (a tied node's, a wrapped periodic axis's): a few
+			// runs in order, so an insertion sort (stable: equal columns are summed in the order they came)
+			// moves only the entries out of place; equal columns side by side are summed
+			const int last   = e;
 			bool      sorted = true;
-			for (int e = first + 1; e < last && sorted; ++e) sorted = column[e - 1] < column[e];
-			if (sorted) {
-				merged[u] = last - first;
-				continue;
+			for (int i = first + 1; i < last && sorted; ++i) sorted = column[i - 1] < column[i];
+			if (!sorted)
+				for (int i = first + 1; i < last; ++i) {
+					const int  col = column[i];
+					const Real v   = value[i];
+					int        j   = i;
+					for (; j > first && column[j - 1] > col; --j) column[j] = column[j - 1], value[j] = value[j - 1];
+					column[j] = col, value[j] = v;
+				}
+			int kept = 0;
+			for (int i = first; i < last; ++i) {
+				if (kept > 0 && column[first + kept - 1] == column[i]) value[first + kept - 1] += value[i];
+				else column[first + kept] = column[i], value[first + kept] = value[i], ++kept;
 			}
-			for (int e = first + 1; e < last; ++e) {
-				const int  col = column[e];
-				const Real v   = value[e];
-				int        j   = e;
-				for (; j > first && column[j - 1] > col; --j) column[j] = column[j - 1], value[j] = value[j - 1];
-				column[j] = col, value[j] = v;
-			}
-			int m = 0;
-			for (int e = first; e < last; ++e) {
-				if (m > 0 && column[first + m - 1] == column[e]) value[first + m - 1] += value[e];
-				else column[first + m] = column[e], value[first + m] = value[e], ++m;
-			}
-			merged[u] = m;
+			merged[u] = kept;
 		}
 		Eigen::SparseMatrix<Real, Eigen::RowMajor>& A = system.matrix;
 		A.resize(n, n); // keeps the entries' storage
