@@ -151,17 +151,24 @@ namespace stages {
 					}
 					for (; asRow < rowStart[r + 1] && extra[static_cast<std::size_t>(asRow)].column <= J; ++asRow) add(r, extra[asRow].column, extra[asRow].value);
 				};
-				for (int o = 0; o < PressureSystem::offsets; ++o) {
-					const int at[3] = { grid.wrap(0, idx[0] + o % 5 - 2), grid.wrap(1, idx[1] + (o / 5) % 5 - 2), grid.wrap(2, idx[2] + o / 25 - 2) };
-					if (at[0] < 0 || at[1] < 0 || at[2] < 0 || at[0] >= grid.nodes[0] || at[1] >= grid.nodes[1] || at[2] >= grid.nodes[2]) continue;
-					const int J = system.row[grid.index(at[0], at[1], at[2])];
-					if (J < 0) continue;
-					// K_rJ: stored in r's row for an offset ≥ 0, in J's for the opposite offset otherwise
-					const Real kJ = o >= centreSlot ? k[o - centreSlot] : rows[static_cast<std::size_t>(J) * PressureSystem::rowStride + (PressureSystem::offsets - 1 - o) - centreSlot];
-					if (kJ == 0) continue; // no point joins them
-					extrasBefore(static_cast<std::size_t>(J));
-					add(r, static_cast<std::size_t>(J), kJ);
-				}
+				int at[3][5]; // the neighbours' indices per axis and offset −2…2, wrapped; −1 off the grid
+				for (int d = 0; d < 3; ++d)
+					for (int i = 0; i < 5; ++i) {
+						const int j = grid.wrap(d, idx[d] + i - 2);
+						at[d][i]    = j >= 0 && j < grid.nodes[d] ? j : -1;
+					}
+				for (int c = 0, o = 0; c < 5; ++c)
+					for (int bb = 0; bb < 5; ++bb)
+						for (int a = 0; a < 5; ++a, ++o) {
+							if (at[0][a] < 0 || at[1][bb] < 0 || at[2][c] < 0) continue;
+							const int J = system.row[grid.index(at[0][a], at[1][bb], at[2][c])];
+							if (J < 0) continue;
+							// K_rJ: stored in r's row for an offset ≥ 0, in J's for the opposite offset otherwise
+							const Real kJ = o >= centreSlot ? k[o - centreSlot] : rows[static_cast<std::size_t>(J) * PressureSystem::rowStride + (PressureSystem::offsets - 1 - o) - centreSlot];
+							if (kJ == 0) continue; // no point joins them
+							extrasBefore(static_cast<std::size_t>(J));
+							add(r, static_cast<std::size_t>(J), kJ);
+						}
 				extrasBefore(active);
 			}
 			system.rhs[u] = b;

@@ -409,6 +409,7 @@ void expectMatrixIsThePairSum(bool periodicX, bool extraPairs = false)
 	EXPECT_EQ(A.nonZeros(), expectedNonZeros);
 	std::printf("%ld unknowns, %ld surface nodes tied to a free neighbour\n", static_cast<long>(A.rows()), tied);
 	EXPECT_GT(fixedColumns, 0); // the drained top's p̄ reached the right-hand side
+	EXPECT_GT(tied, 0);         // and tied nodes joined their masters' rows (the rows sorted and merged)
 	EXPECT_LT((system.rhs - expectedRhs).norm(), 1e-12 * expectedRhs.norm());
 }
 
