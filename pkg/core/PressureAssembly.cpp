@@ -264,7 +264,7 @@ namespace stages {
 			system.mixtureVelocity[I]    = theta * vs + (1 - theta) * vw;
 			system.relativeVelocity[I]   = theta * (vw - vs);
 		}
-		assignKeepingStorage<Real>(system.rows, system.node.size() * PressureSystem::rowStride, 0);
+		assignInParallel<Real>(system.rows, system.node.size() * PressureSystem::rowStride, 0);
 		const Real invKw = 1 / water.bulkModulus; // 0 for incompressible water (Kw = ∞)
 		for (std::size_t s = 0; s < sets.size(); ++s) {
 			const WaterPointSet& P     = *sets[s];
@@ -348,7 +348,9 @@ namespace stages {
 		// sees for the skeleton is the one the skeleton's points feel
 		for (const SolidSet& set : solids) {
 			const SolidPointSet& P = *set.points;
-			scatter(system.rows, system.rowBuffers, P.size(), [&](std::size_t p, Real* rows) {
+			// b alone: the right-hand sides' slot, not the rows' buffers
+			scatterIntoSlot(system.rows.data() + PressureSystem::rhsSlot, system.node.size(), PressureSystem::rowStride, system.rhsBuffers, P.size(),
+			                [&](std::size_t p, Real* rhs, std::size_t stride) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
 				Real n = 0, divS = 0, wet = 0;
@@ -365,7 +367,7 @@ namespace stages {
 				n                 = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 				const Real source = P.volume[p] * (1 - n) * divS;
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
-					if (system.row[I] >= 0) rows[static_cast<std::size_t>(system.row[I]) * PressureSystem::rowStride + PressureSystem::rhsSlot] -= N * source;
+					if (system.row[I] >= 0) rhs[static_cast<std::size_t>(system.row[I]) * stride] -= N * source;
 				});
 			});
 		}

@@ -80,6 +80,7 @@ struct PressureSystem {
 	std::vector<char>        aboveFaceTable; // per pressure node: on a drained face only above that face's water table, where p̄ = 0 is air, not a reservoir
 	std::vector<Real>        rows;           // per pressure node: rowStride values (K's upper half [m³ s⁻¹ Pa⁻¹], then b [m³ s⁻¹])
 	std::vector<std::vector<Real>> rowBuffers; // per extra thread
+	std::vector<std::vector<Real>> rhsBuffers; // per extra thread: b alone (the solid points' pass)
 	std::vector<Real>        fluctuationWeight; // per water point of the set being assembled: V × eq. 8.6b/c's weight of S, 0 where S has none there [m⁵ Pa⁻¹ s⁻¹]
 	std::vector<std::size_t> cellPointStart;    // per occupied cell: where its points start in cellPoints (and the end after the last)
 	std::vector<std::size_t> cellPoints;        // the points with fluctuationWeight > 0, grouped by cell

@@ -140,11 +140,12 @@ namespace mpm::detail {
 			return;
 		}
 		buffers.resize(threads - 1);
-		for (auto& b : buffers) assignKeepingStorage(b, target.size(), zeroOf(Node {}));
 #pragma omp parallel num_threads(threads)
 		{
 			const int tid = omp_get_thread_num();
-			Node*     dst = tid == 0 ? target.data() : buffers[tid - 1].data();
+			// each thread zeroes its own copy: in parallel, and in its own core's cache
+			if (tid > 0) assignKeepingStorage(buffers[tid - 1], target.size(), zeroOf(Node {}));
+			Node* dst = tid == 0 ? target.data() : buffers[tid - 1].data();
 #pragma omp for schedule(static)
 			for (std::size_t p = 0; p < count; ++p) perPoint(p, dst);
 		}
@@ -152,6 +153,40 @@ namespace mpm::detail {
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
 		for (std::size_t i = 0; i < nodes; ++i)
 			for (auto& b : buffers) target[i] += b[i];
+	}
+
+	// `v` set to n copies of `value` in the storage it has, the entries written in parallel (a large
+	// zeroed buffer costs a serial pass otherwise)
+	template <class T> void assignInParallel(std::vector<T>& v, std::size_t n, const T& value)
+	{
+		resizeKeepingStorage(v, n);
+#pragma omp parallel for schedule(static) if(n > parallelThreshold)
+		for (std::size_t i = 0; i < n; ++i) v[i] = value;
+	}
+
+	// scatter into one slot of strided records, target[i * stride] for i < entries: thread 0 adds into
+	// `target`, the others into dense private copies of that slot alone (perPoint(p, base, stride) adds
+	// to base[i * stride]), so a pass that writes one value per record pays for one value per record
+	template <class F> void scatterIntoSlot(Real* target, std::size_t entries, std::size_t stride, std::vector<std::vector<Real>>& buffers, std::size_t count, F&& perPoint)
+	{
+		const int threads = count <= parallelThreshold ? 1 : omp_get_max_threads();
+		if (threads == 1) {
+			for (std::size_t p = 0; p < count; ++p) perPoint(p, target, stride);
+			return;
+		}
+		buffers.resize(threads - 1);
+#pragma omp parallel num_threads(threads)
+		{
+			const int tid = omp_get_thread_num();
+			if (tid > 0) assignKeepingStorage<Real>(buffers[tid - 1], entries, 0);
+			Real*             base = tid == 0 ? target : buffers[tid - 1].data();
+			const std::size_t step = tid == 0 ? stride : 1;
+#pragma omp for schedule(static)
+			for (std::size_t p = 0; p < count; ++p) perPoint(p, base, step);
+		}
+#pragma omp parallel for schedule(static) if(entries > parallelThreshold)
+		for (std::size_t i = 0; i < entries; ++i)
+			for (auto& b : buffers) target[i * stride] += b[i];
 	}
 
 	// Lower node (i, j, k) of the cell holding x.
