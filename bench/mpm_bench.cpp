@@ -25,7 +25,9 @@
 #include <chrono>
 #include <ctime>
 #include <cstdio>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -165,7 +167,18 @@ int main(int argc, char** argv)
 		double sum = 0;
 		for (std::size_t p = 0; p < n; ++p) sum += solid.position[p].sum() + 1e-6 * solid.effectiveStress[p].sum();
 		for (std::size_t p = 0; p < fluid.size(); ++p) sum += 1e-6 * fluid.porePressure[p] + fluid.velocity[p].sum();
-		std::fprintf(stderr, "fingerprint %.17g\n", sum);
+		// and a hash of every bit of that state (FNV-1a): equal only where the results are equal bit for bit
+		std::uint64_t bits = 1469598103934665603ull;
+		auto          hash = [&bits](const double* v, std::size_t count) {
+			for (std::size_t i = 0; i < count; ++i) {
+				std::uint64_t word;
+				std::memcpy(&word, v + i, sizeof word);
+				for (int b = 0; b < 8; ++b) bits = (bits ^ ((word >> (8 * b)) & 0xff)) * 1099511628211ull;
+			}
+		};
+		for (std::size_t p = 0; p < n; ++p) hash(solid.position[p].data(), 3), hash(solid.effectiveStress[p].data(), 6);
+		for (std::size_t p = 0; p < fluid.size(); ++p) hash(&fluid.porePressure[p], 1), hash(fluid.velocity[p].data(), 3);
+		std::fprintf(stderr, "fingerprint %.17g bits %016llx\n", sum, static_cast<unsigned long long>(bits));
 	}
 	return 0;
 }

@@ -19,7 +19,8 @@ namespace stages {
 	{
 		const std::size_t count   = points.size();
 		long              invalid = -1;
-#pragma omp parallel for schedule(static) reduction(max : invalid) if(count > parallelThreshold)
+		const std::size_t chunk   = balancedChunk(count);
+#pragma omp parallel for schedule(static, chunk) reduction(max : invalid) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, points, p, w);

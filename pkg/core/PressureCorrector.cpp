@@ -27,7 +27,8 @@ namespace stages {
 				// the assembly of this step sized the fluxes and no point came or went since: a mismatch is a bug,
 				// not a state to reset (zeroing would drop every point's carried flux silently)
 				if (P.subscaleFlux.size() != P.size()) throw std::logic_error("accumulatePressureForces: the water points' subscale fluxes were not sized by this step's assembly");
-#pragma omp parallel for schedule(static) if(P.size() > parallelThreshold)
+				const std::size_t chunk = balancedChunk(P.size());
+#pragma omp parallel for schedule(static, chunk) if(P.size() > parallelThreshold)
 				for (std::size_t p = 0; p < P.size(); ++p) {
 					Weights1D w[3];
 					weightsAt<Kernel>(grid, P, p, w);

@@ -21,7 +21,8 @@ namespace stages {
 		const bool        plastic = set.model != SkeletonModel::LinearElastic, mohrCoulomb = set.model == SkeletonModel::MohrCoulomb;
 		const std::size_t count  = P.size();
 		long              firstInverted = static_cast<long>(count);
-#pragma omp parallel for schedule(static) reduction(min : firstInverted) if(count > parallelThreshold)
+		const std::size_t chunk         = balancedChunk(count);
+#pragma omp parallel for schedule(static, chunk) reduction(min : firstInverted) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			const Mat3& L    = velocityGradients[p];
 			Mat3        d    = 0.5 * (L + L.transpose());

@@ -211,7 +211,8 @@ namespace stages {
 	{
 		const std::size_t count = P.size();
 		gradients.resize(count);
-#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		const std::size_t chunk = balancedChunk(count);
+#pragma omp parallel for schedule(static, chunk) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, P, p, w);

@@ -388,8 +388,9 @@ template <class Kernel> void TwoPhaseSolver::cacheStencilWeights()
 	auto       fill = [&](MaterialPointSet& P) {
 		const std::size_t count = P.size();
 		P.stencilWeights.resize(count);
-		long first = static_cast<long>(count);
-#pragma omp parallel for schedule(static) reduction(min : first) if(count > parallelThreshold)
+		long              first = static_cast<long>(count);
+		const std::size_t chunk = detail::balancedChunk(count);
+#pragma omp parallel for schedule(static, chunk) reduction(min : first) if(count > parallelThreshold)
 		for (std::size_t p = 0; p < count; ++p) {
 			Weights1D w[3];
 			detail::weightsAt<Kernel>(grid_, P.position[p], P.halfLength[p], w);
