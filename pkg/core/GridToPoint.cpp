@@ -15,7 +15,7 @@ namespace stages {
 	template <class Kernel>
 	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
 	                           const std::vector<Real>* retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt, Real flipBlend,
-	                           const std::vector<char>* picPoints)
+	                           const std::vector<char>* picPoints, const OldGridAtPoints* interpolated)
 	{
 		const std::size_t count   = points.size();
 		long              invalid = -1;
@@ -26,12 +26,20 @@ namespace stages {
 			weightsAt<Kernel>(grid, points, p, w);
 			Vec3 vNew = Vec3::Zero(), vOld = Vec3::Zero(), gained = Vec3::Zero();
 			Real kept = retention ? 0 : 1;
-			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
-				vNew += N * gridVelocityNew[I];
-				vOld += N * gridVelocity[I];
-				if (retention) kept += N * (*retention)[I];
-				if (received) gained += N * (*received)[I];
-			});
+			if (interpolated) {
+				vOld = interpolated->velocity[p];
+				if (retention) kept = interpolated->retention[p];
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+					vNew += N * gridVelocityNew[I];
+					if (received) gained += N * (*received)[I];
+				});
+			} else
+				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+					vNew += N * gridVelocityNew[I];
+					vOld += N * gridVelocity[I];
+					if (retention) kept += N * (*retention)[I];
+					if (received) gained += N * (*received)[I];
+				});
 			// eq. 4.11 written as v̄ + α(v_p − Σ S v^n_I), the unresolved part damped by eq. 4.11b and
 			// the momentum the other phase's points lost to drag received (eq. 4.11c)
 			const Real alpha    = picPoints && (*picPoints)[p] ? 0 : flipBlend; // eq. 4.11d: PIC in an inflow face's cell
@@ -58,13 +66,22 @@ namespace stages {
 
 	template <class Kernel>
 	void scatterDragLoss(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Real>& retention, const MaterialPointSet& points,
-	                     Real flipBlend, const std::vector<char>* picPoints, std::vector<Vec3>& lost, std::vector<std::vector<Vec3>>& buffers)
+	                     Real flipBlend, const std::vector<char>* picPoints, std::vector<Vec3>& lost, std::vector<std::vector<Vec3>>& buffers,
+	                     OldGridAtPoints& interpolated)
 	{
+		interpolated.velocity.resize(points.size());
+		interpolated.retention.resize(points.size());
 		scatter(lost, buffers, points.size(), [&](std::size_t p, Vec3* nodes) {
 			Weights1D w[3];
 			weightsAt<Kernel>(grid, points, p, w);
 			Vec3 vOld = Vec3::Zero();
-			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) { vOld += N * gridVelocity[I]; });
+			Real kept = 0;
+			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
+				vOld += N * gridVelocity[I];
+				kept += N * retention[I];
+			});
+			interpolated.velocity[p]  = vOld;
+			interpolated.retention[p] = kept;
 			const Real alpha      = picPoints && (*picPoints)[p] ? 0 : flipBlend; // PIC points keep no unresolved part to hand over
 			const Vec3 unresolved = alpha * points.mass[p] * (points.velocity[p] - vOld);
 			forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3&) {
@@ -96,8 +113,8 @@ namespace stages {
 	}
 
 #define MPM_INSTANTIATE(K) \
-	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const std::vector<Real>*, const std::vector<Vec3>*, MaterialPointSet&, Real, Real, const std::vector<char>*); \
-	template void scatterDragLoss<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Real>&, const MaterialPointSet&, Real, const std::vector<char>*, std::vector<Vec3>&, std::vector<std::vector<Vec3>>&); \
+	template long updatePointKinematics<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Vec3>&, const std::vector<Real>*, const std::vector<Vec3>*, MaterialPointSet&, Real, Real, const std::vector<char>*, const OldGridAtPoints*); \
+	template void scatterDragLoss<K>(const GridGeometry&, const std::vector<Vec3>&, const std::vector<Real>&, const MaterialPointSet&, Real, const std::vector<char>*, std::vector<Vec3>&, std::vector<std::vector<Vec3>>&, OldGridAtPoints&); \
 	template long firstPointOutsideGrid<K>(const GridGeometry&, const MaterialPointSet&);
 
 	MPM_INSTANTIATE(LinearKernel)

@@ -175,17 +175,25 @@ namespace stages {
 	void applyWallFriction(GridFields& fields, const ConstrainedNodes& constrained, const std::vector<std::array<bool, 3>>& heldSolid, Real dt,
 	                       Real solidMassTolerance, Real waterMassTolerance);
 
+	// Σ S v^n_I and Σ S r_I at each point of a set as scatterDragLoss interpolates them (the same sums in
+	// the same order), for updatePointKinematics to read instead of interpolating them again.
+	struct OldGridAtPoints {
+		std::vector<Vec3> velocity;
+		std::vector<Real> retention;
+	};
+
 	// Step 7 (theory.md eqs. 4.11–4.11c): G2P with FLIP/PIC blend α; the part of the point velocity
 	// the grid does not carry is damped by the drag at the point, `retention` per node
 	// (dragRetention, interpolated; null: not damped), and the velocity `received` per node (null:
 	// none) is added;
 	// positions move with the new grid velocity. Returns the index of the first runaway point, or -1:
 	// one whose velocity is not finite or whose displacement in this step exceeds the cell size (a
-	// CFL violation that no stable explicit step produces).
+	// CFL violation that no stable explicit step produces). With `interpolated` (scatterDragLoss's, of
+	// the same gridVelocity and retention) the points' Σ S v^n_I and Σ S r_I are read from it.
 	template <class Kernel>
 	long updatePointKinematics(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Vec3>& gridVelocityNew,
 	                           const std::vector<Real>* retention, const std::vector<Vec3>* received, MaterialPointSet& points, Real dt,
-	                           Real flipBlend, const std::vector<char>* picPoints = nullptr);
+	                           Real flipBlend, const std::vector<char>* picPoints = nullptr, const OldGridAtPoints* interpolated = nullptr);
 
 	// theory.md eq. 4.11b: per node, the factor 1/(1 + Δt Q_I/m_I) by which the implicit drag Q_I
 	// damps, within one step, a velocity of this phase's points that the other phase does not share
@@ -194,10 +202,12 @@ namespace stages {
 
 	// theory.md eq. 4.11c: adds to `lost` the momentum α (1 − r_I) S_Ip m_p (v_p − Σ S v^n_I) that
 	// eq. 4.11b takes from each point of one phase at each node, before the points move; it goes to
-	// the other phase at that node, so the drag stays internal and the total momentum is kept.
+	// the other phase at that node, so the drag stays internal and the total momentum is kept. Writes
+	// the points' Σ S v^n_I and Σ S r_I to `interpolated` (for updatePointKinematics).
 	template <class Kernel>
 	void scatterDragLoss(const GridGeometry& grid, const std::vector<Vec3>& gridVelocity, const std::vector<Real>& retention, const MaterialPointSet& points,
-	                     Real flipBlend, const std::vector<char>* picPoints, std::vector<Vec3>& lost, std::vector<std::vector<Vec3>>& buffers);
+	                     Real flipBlend, const std::vector<char>* picPoints, std::vector<Vec3>& lost, std::vector<std::vector<Vec3>>& buffers,
+	                     OldGridAtPoints& interpolated);
 
 	// Step 8 (theory.md eq. 4.12): MUSL re-map of the point momenta of one phase to the grid,
 	// written to `remapped` (v̂_I), then the wall constraints of that phase. Momentum and mass are

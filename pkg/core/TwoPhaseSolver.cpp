@@ -759,11 +759,14 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 			stages::dragRetention(fields_, false, solidMassTolerance_, waterMassTolerance_, dt, waterRetention_);
 			solidDragLoss_.assign(grid_.nodeCount(), Vec3::Zero());
 			waterDragLoss_.assign(grid_.nodeCount(), Vec3::Zero());
-			for (const SolidSet& s : solids_)
-				stages::scatterDragLoss<Kernel>(grid_, fields_.solidVelocity, solidRetention_, *s.points, settings_.flipBlend, nullptr, solidDragLoss_, lossBuffers_);
+			solidOldGrid_.resize(solids_.size());
+			waterOldGrid_.resize(waters_.size());
+			for (std::size_t s = 0; s < solids_.size(); ++s)
+				stages::scatterDragLoss<Kernel>(grid_, fields_.solidVelocity, solidRetention_, *solids_[s].points, settings_.flipBlend, nullptr, solidDragLoss_, lossBuffers_,
+				                                solidOldGrid_[s]);
 			for (std::size_t w = 0; w < waters_.size(); ++w)
 				stages::scatterDragLoss<Kernel>(grid_, fields_.waterVelocity, waterRetention_, *waters_[w], settings_.flipBlend,
-				                                inflowCell_.empty() ? nullptr : &inflowCell_[w], waterDragLoss_, lossBuffers_);
+				                                inflowCell_.empty() ? nullptr : &inflowCell_[w], waterDragLoss_, lossBuffers_, waterOldGrid_[w]);
 			// the loss of one phase is the gain of the other (a loss exists only where both carry mass)
 			const std::size_t nodes = solidDragLoss_.size();
 #pragma omp parallel for schedule(static) if(nodes > parallelThreshold)
@@ -778,12 +781,13 @@ template <class Kernel> void TwoPhaseSolver::movePoints(Real dt)
 		const StencilWeightsScope weightsScope { *this };
 		for (std::size_t s = 0; s < solids_.size(); ++s)
 			check(stages::updatePointKinematics<Kernel>(grid_, fields_.solidVelocity, fields_.solidVelocityNew, exchange ? &solidRetention_ : nullptr,
-			                                            exchange ? &solidDragLoss_ : nullptr, *solids_[s].points, dt, settings_.flipBlend),
+			                                            exchange ? &solidDragLoss_ : nullptr, *solids_[s].points, dt, settings_.flipBlend, nullptr,
+			                                            exchange ? &solidOldGrid_[s] : nullptr),
 			      solids_[s].name, *solids_[s].points);
 		for (std::size_t w = 0; w < waters_.size(); ++w)
 			check(stages::updatePointKinematics<Kernel>(grid_, fields_.waterVelocity, fields_.waterVelocityNew, exchange ? &waterRetention_ : nullptr,
 			                                            exchange ? &waterDragLoss_ : nullptr, *waters_[w], dt, settings_.flipBlend,
-			                                            inflowCell_.empty() ? nullptr : &inflowCell_[w]),
+			                                            inflowCell_.empty() ? nullptr : &inflowCell_[w], exchange ? &waterOldGrid_[w] : nullptr),
 			      waterNames_[w], *waters_[w]);
 	}
 	removeOutflowingWater();

@@ -230,6 +230,7 @@ private:
 	PointFieldNames               fieldNames_;
 	std::vector<Vec3>             solidDragLoss_, waterDragLoss_;   // eq. 4.11c per node: momentum lost, then velocity received [m s⁻¹]
 	std::vector<std::vector<Vec3>> lossBuffers_;
+	std::vector<stages::OldGridAtPoints> solidOldGrid_, waterOldGrid_; // per set: what scatterDragLoss interpolated, for the kinematics
 	TimeStepLimits                lastLimits_ {};
 	void                          removeOutflowingWater();
 	// Whether the skeleton holds water at x under still water (eq. 1.9: the outflow and the inflow
