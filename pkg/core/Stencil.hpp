@@ -134,9 +134,9 @@ namespace mpm::detail {
 	inline MomentumNode zeroOf(const MomentumNode&) { return MomentumNode { Vec3::Zero(), 0 }; }
 
 	// A thread's points in a loop over a set come in this many chunks spread over the set: a point's
-	// cost varies with where it is (next to a face, where the subscales flow), and sets are ordered in
-	// space, so one contiguous share per thread leaves one thread waiting at the end (measured on the
-	// column: 14% more time in the second half of the points, one thread alone). Fixed per thread
+	// cost varies along a set (measured on the column: 14% more time in the second half of the points,
+	// one thread alone; why was not traced), so one contiguous share per thread leaves one thread
+	// waiting at the end. Fixed per thread
 	// count: a scatter gives the same points to the same copy from step to step, as its sums' round-off.
 	constexpr std::size_t chunksPerThread = 8;
 	inline std::size_t    balancedChunk(std::size_t count, int threads = omp_get_max_threads())
