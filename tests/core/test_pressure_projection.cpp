@@ -708,3 +708,45 @@ TEST(SurfaceTies, PutThePressuresZeroOnATableSloping30DegreesAcrossTheGrid) { ex
 TEST(SurfaceTies, PutThePressuresZeroOnAnObliqueTableWithThreePointsPerCell) { expectTiesPutTheZeroOnASlopingPlane(3, 0.35, 0.2); }
 
 } // namespace
+
+// The pressure solve's conjugate gradient (PressureSolve.cpp) on the chain −p_{i−1} + 2 p_i − p_{i+1} = 1,
+// p = 0 beyond both ends: its solution is the discrete parabola p_i = (i + 1)(n − i)/2 (second differences
+// of a quadratic are exact). Met to the solve's tolerance, and the same bits on one and on two threads:
+// its dot products run in parallel but are summed in fixed blocks of rows, so the iterates do not depend
+// on the thread count (a plain OpenMP reduction would split the sums by thread and change them).
+TEST(PressureSolve, ConjugateGradientMeetsTheChainsParabolaWithTheSameBitsOnAnyThreadCount)
+{
+	const int      n = 3000; // above parallelThreshold: the parallel region runs with its threads
+	PressureSystem system;
+	system.row.resize(n), system.node.resize(n), system.fixed.assign(n, 0), system.fixedValue.assign(n, 0), system.unknown.resize(n);
+	system.tiedUnknown.resize(n), system.tiedWeight.assign(n, 1);
+	std::vector<Eigen::Triplet<Real>> entries;
+	for (int i = 0; i < n; ++i) {
+		system.row[i] = i, system.node[i] = static_cast<std::size_t>(i), system.unknown[i] = i, system.tiedUnknown[i] = i;
+		entries.emplace_back(i, i, 2.0);
+		if (i > 0) entries.emplace_back(i, i - 1, -1.0);
+		if (i + 1 < n) entries.emplace_back(i, i + 1, -1.0);
+	}
+	system.matrix.resize(n, n);
+	system.matrix.setFromTriplets(entries.begin(), entries.end());
+	system.meanDiagonal = 2;
+	const Real tolerance = 1e-9, peak = 0.25 * (n + 1.0) * (n + 1.0) / 2; // [Pa] (units of the test's p)
+	std::vector<Real> bits[2];
+	long              iterations[2] = { 0, 0 };
+	const int         before        = omp_get_max_threads();
+	for (int threads = 1; threads <= 2; ++threads) {
+		omp_set_num_threads(threads);
+		system.rhs.setOnes(n);
+		system.previousNode.clear();
+		const PressureSolveReport report = stages::solvePressure(system, tolerance);
+		iterations[threads - 1]          = report.iterations;
+		EXPECT_LE(report.residual, tolerance);
+		double worst = 0;
+		for (int i = 0; i < n; ++i) worst = std::max(worst, std::abs(system.nodalPressure[i] - 0.5 * (i + 1.0) * (n - i)));
+		EXPECT_LT(worst, 1e-9 * peak) << threads << " threads";
+		bits[threads - 1] = system.nodalPressure;
+	}
+	omp_set_num_threads(before);
+	EXPECT_EQ(iterations[0], iterations[1]);
+	for (int i = 0; i < n; ++i) ASSERT_EQ(bits[0][i], bits[1][i]) << "node " << i;
+}
