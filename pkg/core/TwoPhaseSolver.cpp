@@ -237,6 +237,7 @@ void TwoPhaseSolver::setPoints(std::vector<SolidSet> solids, std::vector<WaterPo
 		if (waters.empty()) throw InvalidParameter("stillWaterLevel is finite but the scene has no water points: the excess-pressure formulation (theory.md eq. 1.9) is for saturated soil");
 	}
 	solids_ = std::move(solids);
+	unbinSkeleton(); // outflow and inflow read the new skeleton
 	waters_ = std::move(waters);
 	water_  = water;
 	// each water set's regular half-length, the size its inflow rows tile (eq. 2.5): water domains never

@@ -237,9 +237,13 @@ private:
 	// face's wetting): its nodal filling at x is at least ½, or x lies in a solid point's domain
 	bool                          skeletonHolds(const Vec3& x);
 	// Whether x lies in a solid point's domain; the solid points binned by the cell of their centre on
-	// first use after `skeletonBins_.clear()`
+	// first use after unbinSkeleton() (binSkeleton() first where threads call it)
 	bool                          insideSkeleton(const Vec3& x);
+	void                          binSkeleton();
+	void                          unbinSkeleton() { skeletonBins_.clear(), skeletonBinned_ = false; }
 	std::vector<std::pair<std::size_t, std::pair<std::size_t, std::size_t>>> skeletonBins_; // (cell, (set, point)), sorted
+	bool                          skeletonBinned_ = false;
+	std::vector<Real>             removedHere_; // per water point, the mass cut off it this step [kg]
 	std::vector<char>             removeFlags_;
 	std::vector<char>             suctionHolding_; // nodes of the suction-holding free surface (eq. 2.3b)
 	PressureModeScratch           pressureModes_; // scratch of eqs. 4.17b–c

@@ -36,22 +36,33 @@ namespace {
 	constexpr double inflowRowBand = 2.5;
 } // namespace
 
+namespace {
+	long cellAlong(const GridGeometry& grid, const Vec3& y, int d) { return static_cast<long>(std::floor((y[d] - grid.origin[d]) / grid.cellSize)); }
+	std::size_t cellKey(const GridGeometry& grid, long i, long j, long k) { return static_cast<std::size_t>(i + grid.nodes[0] * (j + static_cast<long>(grid.nodes[1]) * k)); }
+	bool inNodeRange(const GridGeometry& grid, long i, long j, long k) { return i >= 0 && j >= 0 && k >= 0 && i < grid.nodes[0] && j < grid.nodes[1] && k < grid.nodes[2]; }
+} // namespace
+
+void TwoPhaseSolver::binSkeleton()
+{
+	if (skeletonBinned_) return;
+	skeletonBins_.clear();
+	for (std::size_t s = 0; s < solids_.size(); ++s) {
+		const SolidPointSet& P = *solids_[s].points;
+		for (std::size_t q = 0; q < P.size(); ++q) {
+			const long i = cellAlong(grid_, P.position[q], 0), j = cellAlong(grid_, P.position[q], 1), k = cellAlong(grid_, P.position[q], 2);
+			if (inNodeRange(grid_, i, j, k)) skeletonBins_.push_back({ cellKey(grid_, i, j, k), { s, q } });
+		}
+	}
+	std::sort(skeletonBins_.begin(), skeletonBins_.end());
+	skeletonBinned_ = true;
+}
+
 bool TwoPhaseSolver::insideSkeleton(const Vec3& x)
 {
-	const Real h      = grid_.cellSize;
-	auto       cellOf = [&](const Vec3& y, int d) { return static_cast<long>(std::floor((y[d] - grid_.origin[d]) / h)); };
-	auto       key    = [&](long i, long j, long k) { return static_cast<std::size_t>(i + grid_.nodes[0] * (j + static_cast<long>(grid_.nodes[1]) * k)); };
-	auto       inGrid = [&](long i, long j, long k) { return i >= 0 && j >= 0 && k >= 0 && i < grid_.nodes[0] && j < grid_.nodes[1] && k < grid_.nodes[2]; };
-	if (skeletonBins_.empty()) {
-		for (std::size_t s = 0; s < solids_.size(); ++s) {
-			const SolidPointSet& P = *solids_[s].points;
-			for (std::size_t q = 0; q < P.size(); ++q) {
-				const long i = cellOf(P.position[q], 0), j = cellOf(P.position[q], 1), k = cellOf(P.position[q], 2);
-				if (inGrid(i, j, k)) skeletonBins_.push_back({ key(i, j, k), { s, q } });
-			}
-		}
-		std::sort(skeletonBins_.begin(), skeletonBins_.end());
-	}
+	auto cellOf = [&](const Vec3& y, int d) { return cellAlong(grid_, y, d); };
+	auto key    = [&](long i, long j, long k) { return cellKey(grid_, i, j, k); };
+	auto inGrid = [&](long i, long j, long k) { return inNodeRange(grid_, i, j, k); };
+	binSkeleton();
 	// a domain that holds x has its centre within its half-length of x: the neighbouring cells hold
 	// every such centre while half-lengths stay below a cell (uGIMP h/4; cpGIMP stretched beyond h
 	// is missed, and the filling's reading stands)
@@ -91,7 +102,7 @@ void TwoPhaseSolver::removeOutflowingWater()
 	for (int f = 0; f < faceCount; ++f) drainedFace = drainedFace || domain_.boundaries.walls[f].water == WaterWall::Drained;
 	if (domain_.sinks.empty() && !domain_.removeWaterLeavingGrid && !domain_.removeFreeWater && !drainedFace && !domain_.boundaries.submerged()) return;
 	const Vec3 faceLower = grid_.lower(), faceUpper = grid_.upper();
-	skeletonBins_.clear(); // the solid points have moved; injectInflowingWater, next, reuses the bins
+	unbinSkeleton(); // the solid points have moved; injectInflowingWater, next, reuses the bins
 	// within an inflow face's rows (eq. 2.5, whose band is in the set's regular spacing, the one its rows
 	// tile; a buffer is thinner) or its cell: the reservoir's water, not seepage out of the soil
 	auto nearInflowRows = [&](const Vec3& x, const Vec3& regularHalfLength) {
@@ -136,17 +147,21 @@ void TwoPhaseSolver::removeOutflowingWater()
 		if (axis < 0) return;
 		const Real inside = l[axis] + nearest, kept = inside / (2 * l[axis]);
 		if (!(kept < 1 - outflowRemnant)) return;
-		removedWaterMass_ += (1 - kept) * w.mass[p];
+		removedHere_[p] += (1 - kept) * w.mass[p];
 		w.mass[p] *= kept;
 		w.volume[p] *= kept;
 		w.halfLength[p][axis] = 0.5 * inside;
 		w.position[p][axis]   = x[axis] - side * l[axis] + side * 0.5 * inside; // the inner end stays
 	};
+	// skeletonHolds bins the skeleton on first use: once, before the threads read it
+	if (domain_.removeFreeWater || domain_.boundaries.submerged()) binSkeleton();
 	for (std::size_t set = 0; set < waters_.size(); ++set) {
 		WaterPointSet*    w = waters_[set];
 		const std::size_t n = w->size();
 		removeFlags_.assign(n, 0);
-		bool any = false;
+		removedHere_.assign(n, 0);
+		// each point decides (and is cut) alone; the masses cut off are summed in point order below
+#pragma omp parallel for schedule(static, detail::balancedChunk(n)) if(n > parallelThreshold)
 		for (std::size_t p = 0; p < n; ++p) {
 			bool out = false;
 			for (const WaterSink& sink : domain_.sinks) out = out || sink.contains(w->position[p]);
@@ -173,7 +188,7 @@ void TwoPhaseSolver::removeOutflowingWater()
 					continue;
 				}
 				const Real kept = inside / (2 * l);
-				removedWaterMass_ += (1 - kept) * w->mass[p];
+				removedHere_[p] += (1 - kept) * w->mass[p];
 				w->mass[p] *= kept;
 				w->volume[p] *= kept;
 				w->halfLength[p][d] = 0.5 * inside;
@@ -188,7 +203,11 @@ void TwoPhaseSolver::removeOutflowingWater()
 					out          = out || !std::isfinite(u) || std::floor(u - 0.5) < 0 || std::floor(u - 0.5) + GimpKernel::stencil > grid_.nodes[d];
 				}
 			removeFlags_[p] = out;
-			any             = any || out;
+		}
+		bool any = false;
+		for (std::size_t p = 0; p < n; ++p) {
+			if (removedHere_[p] != 0) removedWaterMass_ += removedHere_[p];
+			any = any || removeFlags_[p];
 		}
 		if (any) removedWaterMass_ += w->removeWhere(removeFlags_);
 	}
