@@ -94,12 +94,15 @@ namespace stages {
 		std::vector<std::size_t>& start   = system.pointsBefore;
 		assignKeepingStorage(cellKey, P.size(), none);
 		assignKeepingStorage(start, nodes + 1, std::size_t { 0 });
-		for (std::size_t p = 0; p < P.size(); ++p)
+		const std::size_t count = P.size();
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p)
 			if (weight[p] > 0) {
 				const std::array<int, 3> cell = cellOf(grid, P.position[p]);
 				cellKey[p]                    = grid.index(cell[0], cell[1], cell[2]);
-				++start[cellKey[p] + 1];
 			}
+		for (std::size_t p = 0; p < count; ++p)
+			if (cellKey[p] != none) ++start[cellKey[p] + 1];
 		system.occupiedCellNode.clear();
 		system.cellPointStart.clear();
 		for (std::size_t I = 0; I < nodes; ++I) {

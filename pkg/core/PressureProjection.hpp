@@ -124,6 +124,10 @@ struct PressureSystem {
 	Eigen::Matrix<Real, Eigen::Dynamic, 1>     rhs, solution, previousSolution;
 	std::vector<std::size_t>                   previousNode; // grid node of each entry of previousSolution (warm start)
 	Real                                       meanDiagonal = 0; // mean K_JJ of the free rows [m³ s⁻¹ Pa⁻¹]
+	struct ConjugateGradientScratch { // solveFreeRows' vectors, kept from step to step (PressureSolve.cpp)
+		Eigen::Matrix<Real, Eigen::Dynamic, 1> diagonal, inverseDiagonal, residual, direction, product;
+		std::vector<Real>                      partial; // the dot products' block sums
+	} conjugateGradient;
 	// The rigid plate (eq. 2.9): b_J = ∂(Bᵀv)_J/∂V per pressure node (empty: no plate) [m²], the
 	// scale c = Δt/M of the rank-one term c b bᵀ it adds to K [s kg⁻¹], and b·p^{n+1} after the solve,
 	// the pore pressure's total force on the plate's nodes along its axis [N].

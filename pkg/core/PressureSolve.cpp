@@ -249,18 +249,22 @@ namespace stages {
 		// dotBlock rows and the blocks' sums in order: the same bits on any number of threads.
 		class JacobiConjugateGradient {
 		public:
-			explicit JacobiConjugateGradient(const Matrix& K) : K_(K)
+			JacobiConjugateGradient(const Matrix& K, PressureSystem::ConjugateGradientScratch& scratch)
+			        : K_(K), diagonal_(scratch.diagonal), inverseDiagonal_(scratch.inverseDiagonal), r_(scratch.residual), p_(scratch.direction),
+			          q_(scratch.product), partial_(scratch.partial)
 			{
 				const Eigen::Index n = K.rows();
-				diagonal_.setZero(n);
-				inverseDiagonal_.setOnes(n);
+				diagonal_.resize(n);
+				inverseDiagonal_.resize(n);
 #pragma omp parallel for schedule(static) if(n > static_cast<Eigen::Index>(parallelThreshold))
-				for (Eigen::Index i = 0; i < n; ++i)
+				for (Eigen::Index i = 0; i < n; ++i) {
+					diagonal_[i] = 0, inverseDiagonal_[i] = 1;
 					for (int e = K.outerIndexPtr()[i]; e < K.outerIndexPtr()[i + 1]; ++e)
 						if (K.innerIndexPtr()[e] == i) {
 							diagonal_[i] = K.valuePtr()[e];
 							if (diagonal_[i] != 0) inverseDiagonal_[i] = 1 / diagonal_[i];
 						}
+				}
 			}
 
 			// x from its value as the first guess, to |b − K x| < tolerance |b| within maxIterations
@@ -373,9 +377,11 @@ namespace stages {
 				for (Eigen::Index k = 0; k < count; ++k) s += partial[k];
 				return s;
 			}
-			const Matrix&     K_;
-			Vector            diagonal_, inverseDiagonal_, r_, p_, q_;
-			std::vector<Real> partial_;
+			const Matrix&      K_;
+			Vector&            diagonal_;
+			Vector&            inverseDiagonal_;
+			Vector &           r_, &p_, &q_;
+			std::vector<Real>& partial_;
 		};
 	} // namespace
 
@@ -388,7 +394,7 @@ namespace stages {
 			x.setZero(rhs.size());
 			return true;
 		}
-		JacobiConjugateGradient cg(system.matrix);
+		JacobiConjugateGradient cg(system.matrix, system.conjugateGradient);
 		const long              maxIterations = std::max<long>(1000, 2 * rhs.size());
 		Real                    cgTolerance   = std::min<Real>(0.1, tolerance * typical / rhsNorm);
 		CgOutcome               outcome       = cg.solve(rhs, x, cgTolerance, maxIterations);

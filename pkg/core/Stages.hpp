@@ -58,6 +58,7 @@ struct CellBins {
 	std::vector<std::size_t> cell;  // the cell of each point (its lower node's index)
 	std::vector<std::size_t> first; // offset of each cell's points in `point`: grid.nodeCount() + 1 entries
 	std::vector<std::size_t> point; // point indices grouped by cell, ascending within a cell
+	std::vector<std::size_t> cursor; // scratch: per thread and cell, its points' count, then where they go
 };
 
 // Scratch of the over-nonlocal softening (theory.md eq. 7.1c): per grid cell (indexed by its lower node).

@@ -30,11 +30,12 @@ namespace stages {
 
 	void resetGrid(GridFields& fields, bool water)
 	{
-		std::fill(fields.solid.begin(), fields.solid.end(), zeroOf(SolidNode {}));
+		// in parallel: a serial pass over every grid node left the second thread idle (perf, two threads)
+		assignInParallel(fields.solid, fields.solid.size(), zeroOf(SolidNode {}));
 		if (!water) return;
-		std::fill(fields.water.begin(), fields.water.end(), zeroOf(WaterNode {}));
-		std::fill(fields.waterVelocity.begin(), fields.waterVelocity.end(), Vec3::Zero());
-		std::fill(fields.waterVelocityNew.begin(), fields.waterVelocityNew.end(), Vec3::Zero());
+		assignInParallel(fields.water, fields.water.size(), zeroOf(WaterNode {}));
+		assignInParallel<Vec3>(fields.waterVelocity, fields.waterVelocity.size(), Vec3::Zero());
+		assignInParallel<Vec3>(fields.waterVelocityNew, fields.waterVelocityNew.size(), Vec3::Zero());
 	}
 
 	template <class Kernel>
@@ -231,15 +232,43 @@ namespace stages {
 			const std::array<int, 3> c = cellOf(grid, P.position[p]);
 			bins.cell[p]               = grid.index(c[0], c[1], c[2]);
 		}
-		// counting sort, serial and O(N): count, prefix sum, place in point order with first[c] as the
-		// cursor (which leaves it at the next cell's start), then shift the offsets back by one cell
-		bins.first.assign(cells + 1, 0);
-		for (std::size_t p = 0; p < count; ++p) ++bins.first[bins.cell[p] + 1];
-		for (std::size_t c = 0; c < cells; ++c) bins.first[c + 1] += bins.first[c];
+		// counting sort, O(N), each thread on its contiguous share of the points: count per thread and
+		// cell, the cells' offsets (prefix sum), each thread's cursor in a cell after the lower threads'
+		// points, place. Within a cell the lower shares come first, each in point order: ascending.
+		const int threads = count > parallelThreshold ? omp_get_max_threads() : 1;
+		bins.first.resize(cells + 1);
 		bins.point.resize(count);
-		for (std::size_t p = 0; p < count; ++p) bins.point[bins.first[bins.cell[p]]++] = p;
-		for (std::size_t c = cells; c > 0; --c) bins.first[c] = bins.first[c - 1];
-		bins.first[0] = 0;
+		resizeKeepingStorage(bins.cursor, static_cast<std::size_t>(threads) * cells);
+#pragma omp parallel num_threads(threads)
+		{
+			const int         t = omp_get_thread_num(), T = omp_get_num_threads();
+			const std::size_t lo = count * t / T, hi = count * (t + 1) / T;
+			std::size_t*      mine = bins.cursor.data() + static_cast<std::size_t>(t) * cells;
+			std::fill(mine, mine + cells, std::size_t { 0 });
+			for (std::size_t p = lo; p < hi; ++p) ++mine[bins.cell[p]];
+#pragma omp barrier
+#pragma omp for schedule(static)
+			for (std::size_t c = 0; c < cells; ++c) {
+				std::size_t total = 0;
+				for (int u = 0; u < T; ++u) total += bins.cursor[static_cast<std::size_t>(u) * cells + c];
+				bins.first[c + 1] = total;
+			}
+#pragma omp single
+			{
+				bins.first[0] = 0;
+				for (std::size_t c = 0; c < cells; ++c) bins.first[c + 1] += bins.first[c];
+			}
+#pragma omp for schedule(static)
+			for (std::size_t c = 0; c < cells; ++c) {
+				std::size_t at = bins.first[c];
+				for (int u = 0; u < T; ++u) {
+					std::size_t& n = bins.cursor[static_cast<std::size_t>(u) * cells + c];
+					const std::size_t here = n;
+					n = at, at += here;
+				}
+			}
+			for (std::size_t p = lo; p < hi; ++p) bins.point[mine[bins.cell[p]]++] = p;
+		}
 	}
 
 	void sumOverCells(const CellBins& bins, const MaterialPointSet& P, const std::vector<Real>& values, std::vector<Real>& cellSum,

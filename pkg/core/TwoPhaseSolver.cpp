@@ -814,8 +814,11 @@ template <class Kernel> void TwoPhaseSolver::skeletonRates()
 		stages::computeVelocityGradients<Kernel>(grid_, fields_.solidVelocityNew, *solids_[s].points, skeletonGradients_[s]);
 		if (!average) continue;
 		std::vector<Real>& rate = skeletonVolumetric_[s];
-		rate.resize(skeletonGradients_[s].size());
-		for (std::size_t p = 0; p < rate.size(); ++p) rate[p] = skeletonGradients_[s][p].trace();
+		const std::vector<Mat3>& gradient = skeletonGradients_[s];
+		const std::size_t        count    = gradient.size();
+		rate.resize(count);
+#pragma omp parallel for schedule(static) if(count > parallelThreshold)
+		for (std::size_t p = 0; p < count; ++p) rate[p] = gradient[p].trace();
 		stages::binPointsByCell(grid_, *solids_[s].points, cellBins_);
 		stages::averageOverCells(cellBins_, *solids_[s].points, rate, cellSum_, cellVolume_);
 	}

@@ -43,6 +43,14 @@ template <class T> void assignKeepingStorage(std::vector<T>& v, std::size_t n, c
 	v.assign(n, value);
 }
 
+// `v` resized to n, new entries `value`, in the storage it has, grown as assignKeepingStorage: where v is
+// all `value` already (a scatter's zeroed copy), only the new entries are written.
+template <class T> void resizeKeepingStorage(std::vector<T>& v, std::size_t n, const T& value)
+{
+	if (v.capacity() < n) v.reserve(withHeadroom(n));
+	v.resize(n, value);
+}
+
 // `v` resized to n (new entries value-initialised) in the storage it has, grown as assignKeepingStorage.
 template <class T> void resizeKeepingStorage(std::vector<T>& v, std::size_t n)
 {
