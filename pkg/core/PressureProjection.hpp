@@ -11,6 +11,7 @@
 #include <Eigen/SparseCore>
 
 #include <array>
+#include <utility>
 #include <vector>
 
 namespace mpm {
@@ -118,6 +119,9 @@ struct PressureSystem {
 	std::vector<std::vector<int>>                 pairBlockOf;      // (same), per thread: per row, its block in pairBlocks, −1: none
 	std::vector<std::vector<NodePair>>            emittedPairs;     // (same), per thread: the pairs of its share of the rows
 	std::vector<int>      rowCount, cursorScratch, columnScratch; // buildPressureMatrix's scratch, kept from step to step
+	std::vector<std::vector<int>>                 rowSlotScratch;   // (same), per thread and column: its place in a row being merged, −1 between rows
+	std::vector<std::vector<std::pair<int, int>>> rowOrderScratch;  // (same), per thread: that row's distinct (column, place)
+	std::vector<std::vector<Real>>                rowValueScratch;  // (same), per thread: their sums
 	std::vector<Real>     valueScratch;                           // (same)
 	std::vector<int>      memberStart, members;                   // (same): per unknown, the pressure nodes it stands for (its own, those tied to it)
 	std::vector<int>      extraRowStart, extraColumnStart, extraByColumn; // (same): per pressure node, its extra pairs as the row and as the column
