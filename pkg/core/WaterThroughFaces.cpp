@@ -37,9 +37,7 @@ namespace {
 } // namespace
 
 namespace {
-	long cellAlong(const GridGeometry& grid, const Vec3& y, int d) { return static_cast<long>(std::floor((y[d] - grid.origin[d]) / grid.cellSize)); }
-	std::size_t cellKey(const GridGeometry& grid, long i, long j, long k) { return static_cast<std::size_t>(i + grid.nodes[0] * (j + static_cast<long>(grid.nodes[1]) * k)); }
-	bool inNodeRange(const GridGeometry& grid, long i, long j, long k) { return i >= 0 && j >= 0 && k >= 0 && i < grid.nodes[0] && j < grid.nodes[1] && k < grid.nodes[2]; }
+	bool inNodeRange(const GridGeometry& grid, int i, int j, int k) { return i >= 0 && j >= 0 && k >= 0 && i < grid.nodes[0] && j < grid.nodes[1] && k < grid.nodes[2]; }
 } // namespace
 
 void TwoPhaseSolver::binSkeleton()
@@ -49,8 +47,8 @@ void TwoPhaseSolver::binSkeleton()
 	for (std::size_t s = 0; s < solids_.size(); ++s) {
 		const SolidPointSet& P = *solids_[s].points;
 		for (std::size_t q = 0; q < P.size(); ++q) {
-			const long i = cellAlong(grid_, P.position[q], 0), j = cellAlong(grid_, P.position[q], 1), k = cellAlong(grid_, P.position[q], 2);
-			if (inNodeRange(grid_, i, j, k)) skeletonBins_.push_back({ cellKey(grid_, i, j, k), { s, q } });
+			const std::array<int, 3> c = detail::cellOf(grid_, P.position[q]);
+			if (inNodeRange(grid_, c[0], c[1], c[2])) skeletonBins_.push_back({ grid_.index(c[0], c[1], c[2]), { s, q } });
 		}
 	}
 	std::sort(skeletonBins_.begin(), skeletonBins_.end());
@@ -59,19 +57,16 @@ void TwoPhaseSolver::binSkeleton()
 
 bool TwoPhaseSolver::insideSkeleton(const Vec3& x)
 {
-	auto cellOf = [&](const Vec3& y, int d) { return cellAlong(grid_, y, d); };
-	auto key    = [&](long i, long j, long k) { return cellKey(grid_, i, j, k); };
-	auto inGrid = [&](long i, long j, long k) { return inNodeRange(grid_, i, j, k); };
 	binSkeleton();
 	// a domain that holds x has its centre within its half-length of x: the neighbouring cells hold
 	// every such centre while half-lengths stay below a cell (uGIMP h/4; cpGIMP stretched beyond h
 	// is missed, and the filling's reading stands)
-	const long ci = cellOf(x, 0), cj = cellOf(x, 1), ck = cellOf(x, 2);
-	for (long k = ck - 1; k <= ck + 1; ++k)
-		for (long j = cj - 1; j <= cj + 1; ++j)
-			for (long i = ci - 1; i <= ci + 1; ++i) {
-				if (!inGrid(i, j, k)) continue;
-				const std::size_t c     = key(i, j, k);
+	const std::array<int, 3> cell = detail::cellOf(grid_, x);
+	for (int k = cell[2] - 1; k <= cell[2] + 1; ++k)
+		for (int j = cell[1] - 1; j <= cell[1] + 1; ++j)
+			for (int i = cell[0] - 1; i <= cell[0] + 1; ++i) {
+				if (!inNodeRange(grid_, i, j, k)) continue;
+				const std::size_t c     = grid_.index(i, j, k);
 				auto              first = std::lower_bound(skeletonBins_.begin(), skeletonBins_.end(), std::make_pair(c, std::make_pair(std::size_t(0), std::size_t(0))));
 				for (auto it = first; it != skeletonBins_.end() && it->first == c; ++it) {
 					const SolidPointSet& P = *solids_[it->second.first].points;
@@ -206,7 +201,7 @@ void TwoPhaseSolver::removeOutflowingWater()
 		}
 		bool any = false;
 		for (std::size_t p = 0; p < n; ++p) {
-			if (removedHere_[p] != 0) removedWaterMass_ += removedHere_[p];
+			removedWaterMass_ += removedHere_[p];
 			any = any || removeFlags_[p];
 		}
 		if (any) removedWaterMass_ += w->removeWhere(removeFlags_);
