@@ -63,6 +63,7 @@ import numpy as np
 
 import yade_mpm
 import yade_mpm.plotting
+import yade_mpm.slope_stability
 from yade import O
 from yade_mpm import MpmHdf5Recorder, MpmSoilMat, MpmTwoPhaseEngine, MpmWaterMat, calibrate, sandpile
 
@@ -369,6 +370,7 @@ profiles = []  # (time, x, height) of the pile's surface at each HDF5 frame: the
 PROFILE_BINS = np.arange(0, SCENE.flume_length + spacing, 2 * spacing)
 record_positions = []  # the solid points' positions at each record (float32): the first mobilised zone is read at the onset
 lem_records = []   # (time, head, critical circle) at every record: the shallowest slides' limit equilibrium
+record_sections = []  # the limit-equilibrium section (Davis' strength) of every record
 deep_records = []  # (time, head, critical circle ≥ DEEP_SLIDE_CELLS deep, the same at peak strength; None: no such circle) at every frame
 failure = None
 settled = None
@@ -417,7 +419,9 @@ while O.time < DURATION - 0.5 * O.dt:  # O.time sums O.dt: thousands of round-of
     # Bishop's factor of safety on the run's own pressure field at every record (1/70 of the history: the
     # head at which it crosses 1 is resolved as finely as the kinematic onset, 1.8 mm of head on the
     # default and CI histories; at every frame, 5 records, it was 9 mm on the CI rise); ≈ 0.2 s each
-    circle = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing)
+    section = sandpile.pile_section(SCENE, solid, fluid, GRAVITY, CELL, spacing)
+    circle = sandpile.limit_equilibrium(SCENE, solid, fluid, GRAVITY, CELL, spacing, section=section)
+    record_sections.append(section)  # for the back-analysis of the first slide's surface once it is known
     row["lem_factor_of_safety"] = circle.factor
     lem_records.append((O.time, row["head_m"], circle))
     if (record - 1) % records_per_frame == 0:
@@ -501,6 +505,28 @@ lem_summary = {"method": "Bishop simplified, critical circle (yade_mpm.slope_sta
                "lem_deep_onset_head_m": None if lem_deep_onset is None else lem_deep_onset["head_m"],
                "deep_peak_factors": [None if r[3] is None else r[3].factor for r in deep_records], "deep_peak_onset": lem_deep_peak_onset,
                "lem_deep_peak_onset_head_m": None if lem_deep_peak_onset is None else lem_deep_peak_onset["head_m"]}
+
+# --- back-analysis: Spencer's factor on the first slide's own surface, record by record up to failure -------
+# (the engineer's check of an observed slide: on the surface it failed along, with the weights, pressures and
+# strength it failed under, F should reach 1 as it starts; slope_stability.back_analysis_factor closes the band's
+# base to the ground on Rankine's planes). The surface is read at 1 cm (a row of points) on a 2 cm grid: one
+# column's base a row higher or lower changes F by up to a third (doc/sandpile.md)
+back_analysis = None
+if sliding_at_failure is not None:
+    failure_index = next(i for i, r in enumerate(rows) if r["time_s"] >= failure["time_s"] - 1e-9)
+    back_factors = []
+    for section in record_sections[:failure_index + 1]:
+        try:
+            back_factors.append(yade_mpm.slope_stability.back_analysis_factor(section, sliding_at_failure["x_m"], sliding_at_failure["z_m"]))
+        except (RuntimeError, ValueError):  # no Spencer solution on that record's section, or the band above its ground
+            back_factors.append(None)
+    evaluated = [(rows[i]["time_s"], rows[i]["head_m"], f) for i, f in enumerate(back_factors) if f is not None]
+    crossing = yade_mpm.analysis.falls_below([e[0] for e in evaluated], [e[2] for e in evaluated]) if evaluated else None
+    back_analysis = {"method": "Spencer on the sliding surface at failure (the band's base closed to the ground on Rankine's planes), "
+                               "Davis' strength, the run's own pressures, every record up to failure",
+                     "times_s": [r["time_s"] for r in rows[:failure_index + 1]], "factors": back_factors,
+                     "factor_at_failure": back_factors[-1],
+                     "crossing_head_m": None if crossing is None else float(np.interp(crossing, [e[0] for e in evaluated], [e[1] for e in evaluated]))}
 
 # --- kinematic onset, run-out, deposit ---------------------------------------------------------------
 # Under a rising head the onset is where the slope face's displacement grows ten times faster with
@@ -592,6 +618,9 @@ summary = {
     "lem_factor_at_onset": None if onset is None else onset["lem_factor"],
     "lem_deep_onset_head_m": lem_summary["lem_deep_onset_head_m"],
     "lem_deep_peak_onset_head_m": lem_summary["lem_deep_peak_onset_head_m"],
+    "lem_back_analysis": back_analysis,
+    "lem_back_analysis_factor_at_failure": None if back_analysis is None else back_analysis["factor_at_failure"],
+    "lem_back_analysis_head_m": None if back_analysis is None else back_analysis["crossing_head_m"],
     "runout_m": runout,
     # when the history's head first stood above the ground at the inflow face (the crest subsided by the slide): from
     # then on the laboratory reservoir spills over the crest (None: never; also for a submerged pile, whose still
@@ -656,7 +685,9 @@ yade_mpm.plotting.time_series(os.path.join(OUT, "time_series.png"), {key: [r[key
                                    "the same, slides ≥ %d cells deep" % DEEP_SLIDE_CELLS:
                                        ([r[0] for r in deep_records], [None if r[2] is None else r[2].factor for r in deep_records]),
                                    "slides ≥ %d cells deep, peak strength (no Davis)" % DEEP_SLIDE_CELLS:
-                                       ([r[0] for r in deep_records], [None if r[3] is None else r[3].factor for r in deep_records])},
+                                       ([r[0] for r in deep_records], [None if r[3] is None else r[3].factor for r in deep_records]),
+                                   **({} if back_analysis is None else
+                                      {"Spencer on the failure's own surface (back-analysis)": (back_analysis["times_s"], back_analysis["factors"])})},
                               failure_displacement=FAILURE_DISPLACEMENT, failure_time=failure["time_s"] if failure else None)
 print(json.dumps({k: summary[k] for k in ("mode", "run_time_s", "stopped_unstable", "failure", "sliding_surface", "sliding_surface_at_failure", "water_mass_balance",
                                           "stable_before_rise")}, indent=2))

@@ -174,17 +174,12 @@ def pile_points(scene, cell_size, points_per_cell=2):
     return np.stack([X[inside], Y[inside], Z[inside]], axis=1), spacing
 
 
-def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing, min_depth=None, davis=True):
-    """Bishop's critical circle of the pile's downstream slope on the run's current state
-    (yade_mpm.slope_stability): weights from both phases' point masses, pore pressures from the
-    water points, averaged over the flume's width; the sand's peak strength reduced for its
-    non-associated flow by Davis (φ = 36°, ψ = 6° → φ* = 31.9°), or with davis=False the peak itself
-    (the upper bound the model's skeleton can mobilise before it softens); centres over the slope from one
-    cell to four pile heights above the base (the toe's slumps as well as deep slides); slip circles no deeper than the
-    flume base and at least min_depth deep [m] (default one cell: a thinner slide is below what the
-    MPM resolves); with a crest lid, only slides that break through the ground downstream of it (the
-    lid's reaction, which holds the crest down against the excess pressure, is not known to the
-    method). Returns the slope_stability.CriticalCircle (its .factor is the factor of safety)."""
+def pile_section(scene, solid, fluid, gravity, cell_size, point_spacing, davis=True):
+    """The pile's 2D section for limit equilibrium (yade_mpm.slope_stability) on the run's current state:
+    weights from both phases' point masses, pore pressures from the water points, averaged over the
+    flume's width, binned by cell; the sand's peak strength reduced for its non-associated flow by Davis
+    (φ = 36°, ψ = 6° → φ* = 31.9°), or with davis=False the peak itself (the upper bound the model's
+    skeleton can mobilise before it softens)."""
     from . import slope_stability
     strength = slope_stability.Strength(cohesion=0.0, friction_angle=scene.friction_angle, dilatancy_angle=scene.dilatancy_angle)
     if davis:
@@ -195,9 +190,22 @@ def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing, mi
         # method with effective unit weights, equivalent to the total weights with the still water's
         # pressure on the ground surface
         solid_mass, water_mass = solid_mass * (1 - scene.water_density / scene.grain_density), np.zeros(len(water_mass))
-    section = slope_stability.section_from_points(solid.pos, solid_mass, fluid.pos, water_mass, fluid.porePressure, gravity,
-                                                  scene.flume_width, cell_size, strength, direction=1, base_z=0.0,
-                                                  surface_offset=0.5 * point_spacing)
+    return slope_stability.section_from_points(solid.pos, solid_mass, fluid.pos, water_mass, fluid.porePressure, gravity,
+                                               scene.flume_width, cell_size, strength, direction=1, base_z=0.0,
+                                               surface_offset=0.5 * point_spacing)
+
+
+def limit_equilibrium(scene, solid, fluid, gravity, cell_size, point_spacing, min_depth=None, davis=True, section=None):
+    """Bishop's critical circle of the pile's downstream slope on the run's current state (the section of
+    pile_section, with davis as there, or `section` if given, built by it); centres over the slope from one
+    cell to four pile heights above the base (the toe's slumps as well as deep slides); slip circles no deeper than the
+    flume base and at least min_depth deep [m] (default one cell: a thinner slide is below what the
+    MPM resolves); with a crest lid, only slides that break through the ground downstream of it (the
+    lid's reaction, which holds the crest down against the excess pressure, is not known to the
+    method). Returns the slope_stability.CriticalCircle (its .factor is the factor of safety)."""
+    from . import slope_stability
+    if section is None:
+        section = pile_section(scene, solid, fluid, gravity, cell_size, point_spacing, davis)
     height, toe = scene.pile_height, scene.toe_x()
     # centres from one cell above the base (the small circles of a slump at the toe, where the seepage
     # leaves the face: 1-2 cells deep, centres a few cm up) to 4 pile heights (the deep circles), spaced

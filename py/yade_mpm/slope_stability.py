@@ -434,6 +434,51 @@ def critical_circle(section, centres_x, centres_z, radii_per_centre=12, min_dept
     return best
 
 
+def _rise_to_ground(section, x0, z0, angle, towards):
+    """Where the line from (x0, z0) rising at `angle` [rad] above the horizontal, towards −x (towards = −1)
+    or +x (+1), meets the ground: (x, z) [m]; (x0, z0) itself where it lies on or above the ground."""
+    gap = lambda t: section.surface(x0 + towards * t * math.cos(angle)) - (z0 + t * math.sin(angle))
+    if not gap(0.0) > 0:
+        return float(x0), float(z0)
+    span = float(np.ptp(section.surface_x)) + float(np.ptp(section.surface_z))
+    lo, hi = 0.0, span  # the ground lies within the section's extent: past it the line is above
+    if gap(hi) > 0:
+        raise ValueError("the line from (%g, %g) m at %g° does not reach the ground within the section" % (x0, z0, math.degrees(angle)))
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if gap(mid) > 0 else (lo, mid)
+    t = 0.5 * (lo + hi)
+    return float(x0 + towards * t * math.cos(angle)), float(z0 + t * math.sin(angle))
+
+
+def band_slip_surface(section, band_x, band_z):
+    """The slip surface of a back-analysis through a shear band: the band's base (band_x increasing from
+    the scarp's end to the exit's, z; section frame, the mass sliding towards +x) [m], closed to the ground
+    at both ends on Rankine's planes for the section's friction angle φ — up behind the scarp at 45° + φ/2
+    (the active wedge behind a slide) and up beyond the exit at 45° − φ/2 (the passive wedge in front of it),
+    the planes of Rankine's (1857) active and passive states, for a slip surface observed only where it runs
+    through the ground. Returns the polyline (x, z) for slices_of_surface."""
+    section.validate()
+    x, z = np.asarray(band_x, dtype=float), np.asarray(band_z, dtype=float)
+    if x.ndim != 1 or x.size < 2 or x.shape != z.shape or not np.all(np.diff(x) > 0):
+        raise ValueError("band_x = %r m must be at least two increasing abscissae, one per band_z" % (x.tolist(),))
+    phi = section.strength.friction_angle
+    entry = _rise_to_ground(section, x[0], z[0], 0.25 * math.pi + 0.5 * phi, -1)
+    leave = _rise_to_ground(section, x[-1], z[-1], 0.25 * math.pi - 0.5 * phi, +1)
+    xs, zs = [entry[0]] + x.tolist() + [leave[0]], [entry[1]] + z.tolist() + [leave[1]]
+    keep = np.concatenate([[True], np.diff(xs) > 0])  # an end already on the ground adds no segment
+    return np.asarray(xs)[keep], np.asarray(zs)[keep]
+
+
+def back_analysis_factor(section, band_x, band_z, slice_count=40):
+    """Spencer's factor of safety on the slip surface through a shear band's base (band_slip_surface): the
+    engineer's back-analysis of an observed slide, whose factor at failure should be 1 where the section's
+    weights, pore pressures and strength are the ones the slide failed under. Raises spencer's RuntimeError
+    where no interslice inclination balances the mass's moments (seen on small, shallow slides at low loads)."""
+    slip_x, slip_z = band_slip_surface(section, band_x, band_z)
+    return spencer(slices_of_surface(section, slip_x, slip_z, count=slice_count))[0]
+
+
 def infinite_slope_factor(slope_angle, depth, unit_weight, strength, pore_pressure=0.0):
     """F of an infinite slope (inclination β [rad]) on a slip plane parallel to its surface at
     vertical depth d [m]: F = [c + (γ d cos²β − u) tan φ] / (γ d sin β cos β), u the pore pressure

@@ -151,3 +151,41 @@ def test_free_ground_keeps_the_slides_that_break_through_it_and_can_only_raise_t
     assert free.surface()[0].min() < 0  # the unrestricted critical circle breaks through the crest
     edges = closed.slices.x - 0.5 * closed.slices.width, closed.slices.x + 0.5 * closed.slices.width
     assert edges[0].min() >= -1e-9 and closed.factor > free.factor
+
+
+@pytest.mark.parametrize("wedge_deg", [20, 25])
+def test_back_analysis_on_a_plane_through_the_toe_is_culmanns_wedge(wedge_deg):
+    """A dry cohesionless 30° slope (H = 1 m) and a band whose base is the plane from the crest to the toe
+    at θ < 30°, both of its ends on the ground: no Rankine closure is added, and Spencer's factor on the
+    plane is the rigid wedge's closed form F = tan φ / tan θ (Culmann: on one plane with c = 0 the weight's
+    components alone decide it, whatever the wedge's size)."""
+    height, strength = 1.0, lem.Strength(cohesion=0.0, friction_angle=math.radians(30))
+    section = simple_slope(height, 30, 18e3, strength)
+    theta = math.radians(wedge_deg)
+    toe = height / math.tan(math.radians(30))
+    start = toe - height / math.tan(theta)  # where the plane meets the crest
+    band_x = np.linspace(start, toe, 9)
+    band_z = (toe - band_x) * math.tan(theta)
+    slip_x, slip_z = lem.band_slip_surface(section, band_x, band_z)
+    assert np.allclose(slip_x, band_x) and np.allclose(slip_z, band_z)
+    F = lem.back_analysis_factor(section, band_x, band_z)
+    assert abs(F / (math.tan(strength.friction_angle) / math.tan(theta)) - 1) < 1e-6, F
+
+
+def test_back_analysis_closes_a_buried_band_on_rankines_planes():
+    """A band base that starts and ends below the ground (a flat base 0.3 m under a 30° slope's face):
+    the surface gains one segment behind it rising at 45° + φ/2 to the ground (Rankine's active plane) and
+    one beyond it at 45° − φ/2 (the passive plane), both ending on the ground surface."""
+    strength = lem.Strength(cohesion=0.0, friction_angle=math.radians(32))
+    section = simple_slope(1.0, 30, 18e3, strength)
+    band_x = np.array([0.6, 0.9, 1.2])
+    band_z = section.surface(band_x).min() - 0.3 + 0 * band_x
+    slip_x, slip_z = lem.band_slip_surface(section, band_x, band_z)
+    assert slip_x.size == band_x.size + 2
+    phi = strength.friction_angle
+    for (x0, z0), (x1, z1), angle in (((slip_x[1], slip_z[1]), (slip_x[0], slip_z[0]), math.pi / 4 + phi / 2),
+                                      ((slip_x[-2], slip_z[-2]), (slip_x[-1], slip_z[-1]), math.pi / 4 - phi / 2)):
+        assert abs(math.atan2(z1 - z0, abs(x1 - x0)) - angle) < 1e-9
+        assert abs(section.surface(x1) - z1) < 1e-9  # the closure ends on the ground
+    F = lem.back_analysis_factor(section, band_x, band_z)
+    assert np.isfinite(F) and F > 0
