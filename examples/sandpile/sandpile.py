@@ -518,7 +518,7 @@ if sliding_at_failure is not None:
     for section in record_sections[:failure_index + 1]:
         try:
             back_factors.append(yade_mpm.slope_stability.back_analysis_factor(section, sliding_at_failure["x_m"], sliding_at_failure["z_m"]))
-        except (RuntimeError, ValueError):  # no Spencer solution on that record's section, or the band above its ground
+        except RuntimeError:  # no interslice inclination balances this record's moments: no Spencer solution
             back_factors.append(None)
     evaluated = [(rows[i]["time_s"], rows[i]["head_m"], f) for i, f in enumerate(back_factors) if f is not None]
     crossing = yade_mpm.analysis.falls_below([e[0] for e in evaluated], [e[2] for e in evaluated]) if evaluated else None
