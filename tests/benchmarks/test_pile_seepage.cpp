@@ -795,28 +795,29 @@ Discharges meanDischarges(const CrestHeadResult& r, double from)
 // 2.9649e-4 m²/s of steady seepage (the section's finite volumes with the capillary surface's Signorini
 // conditions at 1 mm), about 13 water points of h = 2 cm through the slope in 0.9 s. The steady heads do not
 // depend on k. Asserted, every 2 ms over the whole second and at every water point inside the pile's outline:
-// |p − p_steady| < 0.1 γw H (the issue's bound; measured ≤ 0.083 in the first record, from the initial table,
-// 0.011–0.034 after); the toe's pressure (the node nearest (toe − 3h, h)) changes by less than 1 kPa/s over every
-// 0.05 s record after the first; over 0.1–1 s the inflow as new points within 2% of steady (measured −0.2% and
-// −0.6%; −1.9% and −2.3% while the face's node on its table, the crest's corner, was held as air: theory.md
-// eq. 8.5g) and water leaving through the slope into the filtering cloth; the water mass balance to 1e-12. The
+// |p − p_steady| < 0.1 γw H (the issue's bound); the toe's pressure (the node nearest (toe − 3h, h)) changes by
+// less than 1 kPa/s over every 0.05 s record after the first; over 0.1–1 s the inflow as new points within 2% of
+// steady and water leaving through the slope into the filtering cloth; the water mass balance to 1e-12. The
 // outflow against the inflow, in two ways:
-// - points leave whole once their centre has left the skeleton (the default): within the points'
+// - h = 2 cm, points leave whole once their centre has left the skeleton (the default): within the points'
 //   granularity — one point's water, (h/2)³ n ρw = 0.4 g, is 7.5% of the 0.9 s throughflow here and the water
-//   inside the outline wanders by ±1.5 points between records — so 2% plus one point's (measured +5.15%;
-//   toe ≤ 766 Pa/s);
-// - with `cutSeepageAtOutline` (theory.md eq. 2.4) the water leaves as slivers cut at the outline, every
-//   record, and in pieces of a quarter to a third of a point where a point passes a step of the solid
-//   domains' staircase: within 4%, 2% and such a piece (measured +1.82%, toe ≤ 100 Pa/s; at timeStepFactor
-//   0.35 and 0.25 +4.1% and +4.0%, where the pieces fall in the window; at h = 1 cm +0.88%).
-// The issue's 2% holds here with the cut at this step and at h = 1 cm, not yet at every step at 2 cm
-// (theory.md §8 Open); neither setting holds the field at every point and sample at k = 1e-1 m/s (a gravel:
-// one-step spikes where the discrete conditions change).
+//   inside the outline wanders by ±1.5 points between records — so 2% plus one point's (measured: worst
+//   0.083 γw H, toe ≤ 766 Pa/s, inflow −0.21%, out − in +5.15%);
+// - h = 1 cm with `cutSeepageAtOutline` (theory.md eq. 2.4): the water leaves as slivers cut at the outline,
+//   every step, so the issue's 2% itself (measured 2026-12-03: worst 0.068 γw H, in the first record, from
+//   the initial table; toe ≤ 133 Pa/s; inflow −0.32%; out − in +0.75%; 230 s on one thread). At 2 cm the cut
+//   leaves in pieces of a quarter to a third of a point where a point passes a step of the solid domains'
+//   staircase, each 2% of this throughflow: +1.8% at this step, +4% at timeStepFactor 0.35 and 0.25 (theory.md
+//   §8 Open). Before eq. 8.5b held a tie's surface to the range its master's class implies, this run had one
+//   sample at 0.129 γw H, beside the toe.
+// Neither setting holds the field at every point and sample at k = 1e-1 m/s (a gravel: one-step spikes where
+// the discrete conditions change).
 class PileUnderACrestHead : public ::testing::TestWithParam<bool> {};
 TEST_P(PileUnderACrestHead, WaterCrossesBothFacesAndThePressureIsSteadySeepage)
 {
 	CrestHeadRun run;
-	run.k = 1e-2, run.h = 0.02, run.duration = 1, run.sample = 0.002, run.print = false, run.cutAtOutline = GetParam();
+	run.cutAtOutline = GetParam();
+	run.k = 1e-2, run.h = run.cutAtOutline ? 0.01 : 0.02, run.duration = 1, run.sample = 0.002, run.print = false;
 	const CrestHeadResult r = runPileUnderACrestHead(run);
 	ASSERT_EQ(r.records.size(), 20u);
 	double worst = 0, toeRate = 0;
@@ -837,12 +838,12 @@ TEST_P(PileUnderACrestHead, WaterCrossesBothFacesAndThePressureIsSteadySeepage)
 	EXPECT_LT(toeRate, 1000.0);
 	EXPECT_NEAR(q.in, r.inflowSteady, 0.02 * r.inflowSteady);
 	EXPECT_GT(q.out, 0); // water leaves through the slope into the cloth
-	if (run.cutAtOutline) EXPECT_NEAR(q.out, q.in, 0.04 * q.in);
+	if (run.cutAtOutline) EXPECT_NEAR(q.out, q.in, 0.02 * q.in);
 	else EXPECT_NEAR(q.out, q.in, 0.02 * q.in + oneWindow);
 	EXPECT_LT(std::abs(r.balance), 1e-12);
 }
 INSTANTIATE_TEST_SUITE_P(PileSeepage, PileUnderACrestHead, ::testing::Values(false, true),
-                         [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "cutAtOutline" : "wholePoints"; });
+                         [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "cutAtOutlineOneCentimetre" : "wholePointsTwoCentimetres"; });
 
 // Not a test: the study of theory.md §8 Open, "The pile's seepage under a crest head, with its capillary
 // surface": the run above with k = MPM_PILE_K (default 0.1 m/s, gravel), h = MPM_PILE_CELL (default 0.02 m),
@@ -857,7 +858,7 @@ INSTANTIATE_TEST_SUITE_P(PileSeepage, PileUnderACrestHead, ::testing::Values(fal
 // (toe − 3h, h), between samples and over the record), the water inside and outside the outline with the
 // inside points' volumes against the mixture their water fills and the nodes' filling deep inside and along
 // the surface, the balance and the fastest water point; at the end the mean discharges from 0.1 s on and the
-// stored water's least-squares slope. About 40 s on two cores at 2 cm, 5 min on one at 1 cm:
+// stored water's least-squares slope. About 40 s on two cores at 2 cm, 4 min on one at 1 cm:
 //   mpm_benchmark_tests --gtest_also_run_disabled_tests --gtest_filter=PileSeepage.DISABLED_CapillarySurfaceUnderACrestHead
 TEST(PileSeepage, DISABLED_CapillarySurfaceUnderACrestHead)
 {
