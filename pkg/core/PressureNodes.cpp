@@ -163,9 +163,10 @@ namespace stages {
 				// a plane surface normal to the axis lies at least (1 − √(2(1 − β))) h beyond a free node
 				// (filling ≥ β = freeSurfaceFilling, hat support), so a wet length that puts it closer to the
 				// master disagrees with the master's class by the two measures' difference (hat-weighted
-				// filling, node-cell volumes): s is held to that range (|c| ≤ 2.4). Left untied there, as
-				// before, the node put p = 0 a whole cell from the master — c jumping from −2.4 to 0 as s
-				// crossed the bound (an impulse of 0.13 γw H beside the crest-head pile's toe at h = 1 cm)
+				// filling, node-cell volumes): s is held to that range (|c| ≤ 2.4 from a master one cell
+				// inwards, 5.9 from one two cells). Left untied there, as before, the node put p = 0 a whole
+				// cell from the master — c jumping from −2.4 to 0 as s crossed the bound (an impulse of
+				// 0.13 γw H beside the crest-head pile's toe at h = 1 cm)
 				const Real gap = std::max(cells * h - s, (1 - std::sqrt(2 * (1 - freeSurfaceFilling))) * h); // from the master to the surface
 				master[r]      = inner;
 				factor[r]      = -(cells * h - gap) / gap;
