@@ -5,9 +5,9 @@
 #   compare    scripts/compare.sh: doc/compare/ (MPM against DEM + PFV), doc/tradeoffs.md and
 #              doc/figures/tradeoffs.* (20-40 min; see that script for reusing stored runs)
 #   pile       examples/sandpile/sandpile.py, quick mode (h = 2 cm):
-#              the main job's scene (yade_mpm.sandpile.DEFAULT, laboratory history): doc/figures/sandpile_quick_* (8-10 min on one thread);
+#              the main job's scene (yade_mpm.sandpile.DEFAULT, laboratory history): doc/figures/sandpile_quick_* (6 min on one thread, 2026-12-03);
 #              with --full also the same scene at h = 1 cm with α held (--inertia-release inf):
-#              doc/figures/sandpile_full_* (50 min on two threads, 42 min on one, 2300-4500 CPU s). α is held because released at 26-27 s the
+#              doc/figures/sandpile_full_* (41 min on one thread, 2026-12-03; 2300-4500 CPU s). α is held because released at 26-27 s the
 #              true inertia's step would make it 6-7 h (the step-error measurements on the quick pile, doc/sandpile.md
 #              Cost knobs, find α costs no accuracy at equal Δt/α). Both modes spill the reservoir over the crest once
 #              the history's head reaches the ground at the inflow face (the example's default, --spill-at-ground: from
