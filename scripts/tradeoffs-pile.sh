@@ -20,7 +20,8 @@
 # sharing the machine do not stretch (though a busy host slows both: the same runs measured about half as much
 # on 2026-11-28's second sweep as on its first). Second sweep (solver CPU time): about 18 minutes for the runs at
 # C = 0.5, α ≥ 10 and h = 2 cm together, the three B rows included; C = 0.25 and 0.125 9 more; α = 10 at C = 0.158 16;
-# α released at ε = 0.01 13; α = 1 16; h = 1 cm 11 — about 90 minutes in all. At h = 1 cm α is held (ε = ∞) as it stays at
+# α released at ε = 0.01 13; α = 1 16; h = 1 cm 11 — about 90 minutes in all. On 2026-12-04 (this code, two runs at a time): 100 minutes in all,
+# the α = 10 at C = 0.158, α = 1 and ε = 0.01 runs 16-18 minutes each, h = 1 cm 13. At h = 1 cm α is held (ε = ∞) as it stays at
 # h = 2 cm (where the release never fires): at 1 cm the toe's tip slumps from the starting head and would release
 # α at 10-12 s, after which each step costs ten times as much and the step's error, of order Δt/α, is ten
 # times larger (doc/sandpile.md), so the row would compare that, not the cell size.
