@@ -163,3 +163,32 @@ def test_the_head_at_which_the_face_has_moved_one_percent_of_h_is_listed_over_th
     kwlow = [c.strip() for c in next(l for l in lines if "Kw/10" in l).split("|")]
     column = header.index("face 1% H head [mm]")
     assert baseline[column] == "50.0" and kwlow[column] == "–"
+
+
+def test_labels_of_runs_at_the_same_cost_and_answer_do_not_overlap_and_stay_in_the_axes():
+    # Runs of about the same cost and answer (the baseline and its Kw row, the two FLIP rows) used to
+    # print their labels on top of each other. Four markers at one point inside the axes and one at the
+    # right edge: every label's box (as label_offsets estimates it) must overlap no other and stay inside
+    # the axes.
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(5, 4))
+    marks = [(100.0, 56.1, "baseline"), (101.0, 56.1, "Kw=2.2GPa"), (100.0, 56.1, "B=0.9"), (100.5, 56.0, "B=0.75"), (1000.0, 50.0, "α=10,C=0.158"), (30.0, 70.0, "linear"), (300.0, 40.0, "C=0.125")]
+    for x, y, _ in marks:
+        ax.plot(x, y, "o")
+    ax.set_xscale("log")
+    fig.tight_layout()
+    offsets = pile_tradeoffs.label_offsets(ax, marks, dpi=fig.dpi)
+    scale = 72.0 / fig.dpi
+    frame = [scale * v for v in ax.get_window_extent().extents]
+    boxes = []
+    for (x, y, text), (dx, dy) in zip(marks, offsets):
+        px, py = (scale * v for v in ax.transData.transform((x, y)))
+        width = 0.6 * pile_tradeoffs.LABEL_SIZE * len(text)
+        boxes.append((px + dx, px + dx + width, py + dy, py + dy + 1.2 * pile_tradeoffs.LABEL_SIZE))
+    plt.close(fig)
+    for i, a in enumerate(boxes):
+        assert frame[0] <= a[0] and a[1] <= frame[2] and frame[1] <= a[2] and a[3] <= frame[3], (marks[i], a, frame)
+        for j, b in enumerate(boxes[:i]):
+            assert not (a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]), (marks[i], marks[j])
