@@ -100,6 +100,20 @@ def test_compliance_onset_is_where_the_load_displacement_curve_softens_tenfold()
         analysis.compliance_onset(heads, u, ratio=1.0)
 
 
+def test_creep_rate_is_the_slope_of_the_displacement_over_the_held_window():
+    """u = u0 + r t + a sin(2π t / 0.4 s) sampled every 0.4 s is exactly linear at the records (the
+    sine vanishes there): the slope over [1, 3] s is r; a settling before the window (u0 jumps at
+    t < 1 s) does not enter; fewer than 3 records in the window give None."""
+    from yade_mpm import analysis
+    t = np.arange(0.4, 6.01, 0.4)
+    r = 9.35e-6
+    u = 1e-5 + r * t + 3e-6 * np.sin(2 * np.pi * t / 0.4) + np.where(t < 1.0, -4e-6, 0.0)
+    assert analysis.creep_rate(t, u, 1.0, 3.0) == pytest.approx(r, rel=1e-6)
+    assert analysis.creep_rate(t, u, 1.0, 1.5) is None
+    with pytest.raises(ValueError, match="end"):
+        analysis.creep_rate(t, u, 3.0, 1.0)
+
+
 def test_sliding_surface_is_the_base_of_the_moving_mass_in_its_start_positions():
     """Points of a 30° slope on a lattice; those above a plane 2 cm under the slope face move: the
     surface found lies one offset under the lowest moving point of each column, between the first and
