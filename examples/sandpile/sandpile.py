@@ -604,11 +604,12 @@ summary = {
     "stable_before_rise": {"toe_displacement_m": settled["toe_displacement_m"] if settled else None,
                            "face_displacement_m": settled["face_displacement_m"] if settled else None,
                            "max_solid_speed_m_per_s": settled["max_solid_speed_m_per_s"] if settled else None,
-                           # over the settling's second half, the head held: the step-set creep (∝ Δt/α) that
-                           # floors the onset criteria (yade_mpm.analysis.creep_rate, doc/sandpile.md)
+                           # over the settling's last two thirds (past the first response to the start; two records
+                           # on the default history), the head held: the step-set creep (∝ Δt/α) that floors the
+                           # onset criteria (yade_mpm.analysis.creep_rate, doc/sandpile.md)
                            **{"%s_creep_rate_m_per_s" % part: yade_mpm.analysis.creep_rate(
                                [r["time_s"] for r in rows], [r["%s_displacement_m" % part] for r in rows],
-                               0.5 * SCENE.settle_time, SCENE.settle_time) if settled and SCENE.settle_time > 0 else None
+                               SCENE.settle_time / 3, SCENE.settle_time) if settled and SCENE.settle_time > 0 else None
                               for part in ("toe", "face")}},
     "failure": None if failure is None else {"time_s": failure["time_s"], "head_m": failure["head_m"],
                                               "face_displacement_m": failure["face_displacement_m"],

@@ -36,14 +36,14 @@ def creep_rate(times, displacements, start, end):
     `displacements` [m] over the records with start ≤ t ≤ end [s]. On the sand pile at its starting
     head this is the toe's creep, whose rate is set by the step (∝ Δt/α, doc/sandpile.md): it is the
     floor of the compliance and kinetic onsets, so a run whose creep is not small against the slide's
-    speeds reads step-dependent onsets. None if fewer than 3 records lie in the window."""
+    speeds reads step-dependent onsets. None if fewer than 2 records lie in the window."""
     if not end > start:
         raise ValueError("end = %r s must exceed start = %r s" % (end, start))
     t, u = np.asarray(times, dtype=float), np.asarray(displacements, dtype=float)
     if t.shape != u.shape:
         raise ValueError("times and displacements must have the same length")
     use = (t >= start) & (t <= end)
-    if use.sum() < 3:
+    if use.sum() < 2:
         return None
     return float(np.polyfit(t[use], u[use], 1)[0])
 

@@ -103,12 +103,13 @@ def test_compliance_onset_is_where_the_load_displacement_curve_softens_tenfold()
 def test_creep_rate_is_the_slope_of_the_displacement_over_the_held_window():
     """u = u0 + r t + a sin(2π t / 0.4 s) sampled every 0.4 s is exactly linear at the records (the
     sine vanishes there): the slope over [1, 3] s is r; a settling before the window (u0 jumps at
-    t < 1 s) does not enter; fewer than 3 records in the window give None."""
+    t < 1 s) does not enter; two records give their slope, fewer give None."""
     from yade_mpm import analysis
     t = np.arange(0.4, 6.01, 0.4)
     r = 9.35e-6
     u = 1e-5 + r * t + 3e-6 * np.sin(2 * np.pi * t / 0.4) + np.where(t < 1.0, -4e-6, 0.0)
     assert analysis.creep_rate(t, u, 1.0, 3.0) == pytest.approx(r, rel=1e-6)
+    assert analysis.creep_rate(t, u, 1.1, 1.7) == pytest.approx(r, rel=1e-6)  # the records at 1.2 and 1.6 s
     assert analysis.creep_rate(t, u, 1.0, 1.5) is None
     with pytest.raises(ValueError, match="end"):
         analysis.creep_rate(t, u, 3.0, 1.0)
