@@ -210,43 +210,52 @@ LABEL_SIZE = 7  # [pt]
 # Where a marker's label may go, as (side, rise): to its right (side 1) or left (−1), raised by `rise`
 # points; tried in turn (up-right first, then stacked above and below, then the left side), so that
 # runs of about the same cost and answer stay readable.
-LABEL_PLACES = [(1, 3)] + [(1, 3 + s * 9 * k) for k in range(1, 7) for s in (1, -1)] + [(-1, 3 + s * 9 * k) for k in range(0, 7) for s in (1, -1)]
+LABEL_PLACES = [(side, 3 + s * 9 * k) for side in (1, -1) for k in range(7) for s in ((1,) if k == 0 else (1, -1))]
 LABEL_GAP = 3  # between a marker and its label [pt]
+MARKER_RADIUS = 3.5  # half a marker's size at matplotlib's default of 6 pt [pt]
 
 
-def _label_box(x, y, place, text, size):
-    """The box (x0, x1, y0, y1) in points that a label of `text` at `place` from (x, y) covers (a
-    character's advance taken as 0.6 of the font size, its line as 1.2) and the label's offset."""
-    width = 0.6 * size * len(text)
-    dx = LABEL_GAP if place[0] > 0 else -LABEL_GAP - width
-    x0, y0 = x + dx, y + place[1]
-    return (x0, x0 + width, y0, y0 + 1.2 * size), (dx, place[1])
-
-
-def label_offsets(ax, marks, size=LABEL_SIZE, dpi=72.0, places=LABEL_PLACES):
-    """An offset in points for the label of each (x, y, text) of marks (data coordinates of ax): the first
-    of `places` whose box stays inside the axes and overlaps no label already placed and no other marker,
-    else the first that only keeps clear of the labels, else one clear of the labels past the axes' edge
-    (greedy, in the order given); the first place when none is free."""
-    scale = 72.0 / dpi
-    frame = [scale * v for v in ax.get_window_extent().extents]  # x0, y0, x1, y1 [pt]
+def label_offsets(ax, marks, size=LABEL_SIZE, places=LABEL_PLACES):
+    """An offset in points for the label of each (x, y, text) of marks (data coordinates of ax, whose
+    layout is final): the first of `places` whose box (the text's extent as the figure's renderer draws
+    it) stays inside the axes and overlaps no label already placed and no other marker, else the first
+    that only keeps clear of the labels, else one clear of the labels past the axes' edge (greedy, in the
+    order given); the first place when none is free."""
+    from matplotlib.font_manager import FontProperties
+    renderer = ax.figure.canvas.get_renderer()
+    scale = 72.0 / ax.figure.dpi  # display pixels to points
+    frame = [scale * v for v in ax.get_window_extent(renderer).extents]  # x0, y0, x1, y1 [pt]
     at = [tuple(scale * v for v in ax.transData.transform((x, y))) for x, y, _ in marks]
     placed, result = [], []
-    radius = 3.5  # a marker's half size [pt]
     for i, ((x, y), (_, _, text)) in enumerate(zip(at, marks)):
+        width, height, _ = (scale * v for v in renderer.get_text_width_height_descent(text, FontProperties(size=size), ismath=False))
+
+        def box_at(place):
+            dx = LABEL_GAP if place[0] > 0 else -LABEL_GAP - width
+            return (x + dx, x + dx + width, y + place[1], y + place[1] + height), (dx, place[1])
+
         def free(b, clear_of_markers, within_frame=True):
             inside = not within_frame or (frame[0] <= b[0] and b[1] <= frame[2] and frame[1] <= b[2] and b[3] <= frame[3])
             apart = not any(b[0] < q[1] and q[0] < b[1] and b[2] < q[3] and q[2] < b[3] for q in placed)
-            clear = not clear_of_markers or not any(j != i and b[0] - radius < mx < b[1] + radius and b[2] - radius < my < b[3] + radius
+            clear = not clear_of_markers or not any(j != i and b[0] - MARKER_RADIUS < mx < b[1] + MARKER_RADIUS and b[2] - MARKER_RADIUS < my < b[3] + MARKER_RADIUS
                                                     for j, (mx, my) in enumerate(at))
             return inside and apart and clear
-        candidates = [_label_box(x, y, place, text, size) for place in places]
+        candidates = [box_at(place) for place in places]
         # clear of the other markers if it can be, else of the other labels only, else past the axes' edge
         box, offset = (next((c for c in candidates if free(c[0], True)), None) or next((c for c in candidates if free(c[0], False)), None)
                        or next((c for c in candidates if free(c[0], False, False)), candidates[0]))
         placed.append(box)
         result.append(offset)
     return result
+
+
+def annotate_marks(ax, marks, size=LABEL_SIZE):
+    """Label each (x, y, text) of marks on ax at label_offsets' places (a thin leader line to a label
+    moved off its first place); returns the annotations."""
+    first = (LABEL_GAP, LABEL_PLACES[0][1])
+    return [ax.annotate(text, (x, y), fontsize=size, xytext=offset, textcoords="offset points",
+                        arrowprops=None if offset == first else dict(arrowstyle="-", lw=0.4, color="0.5"))
+            for (x, y, text), offset in zip(marks, label_offsets(ax, marks, size))]
 
 
 def figure(path, rows):
@@ -273,9 +282,7 @@ def figure(path, rows):
     fig.suptitle("the sand pile: answer against cost (one knob at a time)", fontsize=9)
     fig.tight_layout()
     for ax, marks in labels.items():  # once the axes are laid out: their scale is final
-        for (t, y, text), offset in zip(marks, label_offsets(ax, marks, LABEL_SIZE, fig.dpi)):
-            ax.annotate(text, (t, y), fontsize=LABEL_SIZE, xytext=offset, textcoords="offset points",
-                        arrowprops=None if offset == (LABEL_GAP, LABEL_PLACES[0][1]) else dict(arrowstyle="-", lw=0.4, color="0.5"))
+        annotate_marks(ax, marks)
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return fig

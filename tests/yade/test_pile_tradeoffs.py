@@ -167,28 +167,28 @@ def test_the_head_at_which_the_face_has_moved_one_percent_of_h_is_listed_over_th
 
 def test_labels_of_runs_at_the_same_cost_and_answer_do_not_overlap_and_stay_in_the_axes():
     # Runs of about the same cost and answer (the baseline and its Kw row, the two FLIP rows) used to
-    # print their labels on top of each other. Four markers at one point inside the axes and one at the
-    # right edge: every label's box (as label_offsets estimates it) must overlap no other and stay inside
-    # the axes.
+    # print their labels on top of each other. Four markers at one point inside the axes, one at the
+    # right edge and two apart, labelled as figure() labels them: the labels as drawn (their text's
+    # extent from the renderer, not label_offsets' own boxes) overlap no other and stay inside the axes.
+    # With every label at its first place (up-right of its marker) the four at one point would overlap.
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.text import Text
     fig, ax = plt.subplots(figsize=(5, 4))
-    marks = [(100.0, 56.1, "baseline"), (101.0, 56.1, "Kw=2.2GPa"), (100.0, 56.1, "B=0.9"), (100.5, 56.0, "B=0.75"), (1000.0, 50.0, "α=10,C=0.158"), (30.0, 70.0, "linear"), (300.0, 40.0, "C=0.125")]
+    marks = [(100.0, 56.1, "baseline"), (101.0, 56.1, "Kw=2.2GPa"), (100.0, 56.1, "B=0.9"), (100.5, 56.0, "B=0.75"),
+             (1000.0, 50.0, "α=10,C=0.158"), (30.0, 70.0, "linear"), (300.0, 40.0, "C=0.125")]
     for x, y, _ in marks:
         ax.plot(x, y, "o")
     ax.set_xscale("log")
     fig.tight_layout()
-    offsets = pile_tradeoffs.label_offsets(ax, marks, dpi=fig.dpi)
-    scale = 72.0 / fig.dpi
-    frame = [scale * v for v in ax.get_window_extent().extents]
-    boxes = []
-    for (x, y, text), (dx, dy) in zip(marks, offsets):
-        px, py = (scale * v for v in ax.transData.transform((x, y)))
-        width = 0.6 * pile_tradeoffs.LABEL_SIZE * len(text)
-        boxes.append((px + dx, px + dx + width, py + dy, py + dy + 1.2 * pile_tradeoffs.LABEL_SIZE))
+    labels = pile_tradeoffs.annotate_marks(ax, marks)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    boxes = [Text.get_window_extent(a, renderer) for a in labels]  # the text alone, without its leader line
     plt.close(fig)
     for i, a in enumerate(boxes):
-        assert frame[0] <= a[0] and a[1] <= frame[2] and frame[1] <= a[2] and a[3] <= frame[3], (marks[i], a, frame)
+        assert frame.x0 <= a.x0 and a.x1 <= frame.x1 and frame.y0 <= a.y0 and a.y1 <= frame.y1, (marks[i], a, frame)
         for j, b in enumerate(boxes[:i]):
-            assert not (a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]), (marks[i], marks[j])
+            assert not a.overlaps(b), (marks[i], marks[j])
