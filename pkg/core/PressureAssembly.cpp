@@ -269,9 +269,13 @@ namespace stages {
 		}
 		assignInParallel<Real>(system.rows, system.node.size() * PressureSystem::rowStride, 0);
 		const Real invKw = 1 / water.bulkModulus; // 0 for incompressible water (Kw = ∞)
+		const bool keepSubscaleWeights = stabilised && system.dynamicSubscales; // for the update after the solve (accumulatePressureForces)
+		system.subscaleInstant.resize(keepSubscaleWeights ? sets.size() : 0);
+		system.subscaleMemory.resize(keepSubscaleWeights ? sets.size() : 0);
 		for (std::size_t s = 0; s < sets.size(); ++s) {
 			const WaterPointSet& P     = *sets[s];
 			system.fluctuationWeight.resize(P.size());
+			if (keepSubscaleWeights) system.subscaleInstant[s].resize(P.size()), system.subscaleMemory[s].resize(P.size());
 			scatter(system.rows, system.rowBuffers, P.size(), [&](std::size_t p, Real* rows) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
@@ -316,6 +320,7 @@ namespace stages {
 				if (system.dynamicSubscales) {
 					const SubscaleWeights sw = subscaleWeights(darcy, lambda, dt);
 					darcy = sw.instant, memory = sw.memory;
+					if (keepSubscaleWeights) system.subscaleInstant[s][p] = sw.instant, system.subscaleMemory[s][p] = sw.memory;
 				}
 				if (darcy > 0) conductance += Vec3::Constant(V * darcy);
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n

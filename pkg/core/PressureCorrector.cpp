@@ -19,40 +19,19 @@ namespace stages {
 	                              const std::vector<Real>& pressure, bool storePointPressures, PressureSystem& system)
 	{
 		system.forces.assign(grid.nodeCount(), zeroOf(PressureForceNode {}));
-		// eq. 8.6c: q′^{n+1} = memory q′^n − instant Σ_J G_J p_J^{n+1}, with the weights of the assembly
-		if (storePointPressures && system.dynamicSubscales && !system.darcyConductance.empty()) {
-			constexpr int S = Kernel::stencil;
-			for (WaterPointSet* set : sets) {
-				WaterPointSet& P = *set;
-				// the assembly of this step sized the fluxes and no point came or went since: a mismatch is a bug,
-				// not a state to reset (zeroing would drop every point's carried flux silently)
-				if (P.subscaleFlux.size() != P.size()) throw std::logic_error("accumulatePressureForces: the water points' subscale fluxes were not sized by this step's assembly");
-				const std::size_t chunk = balancedChunk(P.size());
-#pragma omp parallel for schedule(static, chunk) if(P.size() > parallelThreshold)
-				for (std::size_t p = 0; p < P.size(); ++p) {
-					Weights1D w[3];
-					weightsAt<Kernel>(grid, P, p, w);
-					int node[3][S];
-					stencilNodes(grid, w, node);
-					Real darcy;
-					Vec3 lambda, dN[S][S][S], G[S][S][S];
-					darcyAtPoint<S>(grid, w, node, system, true, dN, darcy, lambda);
-					const SubscaleWeights sw = subscaleWeights(darcy, lambda, system.subscaleStep);
-					int corner[3], lo[3], hi[3];
-					if (!(sw.instant > 0) || !fluctuationGradients<S>(grid, P.position[p], w, dN, G, corner, lo, hi)) {
-						P.subscaleFlux[p].setZero();
-						continue;
-					}
-					Vec3 g = Vec3::Zero();
-					for (int c = lo[2]; c < hi[2]; ++c)
-						for (int b = lo[1]; b < hi[1]; ++b)
-							for (int a = lo[0]; a < hi[0]; ++a) g += pressure[grid.index(node[0][a], node[1][b], node[2][c])] * G[c][b][a];
-					P.subscaleFlux[p] = sw.memory * P.subscaleFlux[p] - sw.instant * g;
-				}
-			}
-		}
+		constexpr int S = Kernel::stencil;
+		// eq. 8.6c: q′^{n+1} = memory q′^n − instant Σ_J G_J p_J^{n+1}, with the assembly's weights, in the
+		// water points' pass below: Σ_J G_J p_J = Σ_J ∇S_J p_J − Σ_{J of the cell} ∇N_J(x_c) p_J, the pressure
+		// gradient the pass sums anyway less the cell's mean one
+		const bool track = storePointPressures && system.dynamicSubscales && !system.darcyConductance.empty();
+		if (track && system.subscaleInstant.size() != sets.size())
+			throw std::logic_error("accumulatePressureForces: the subscale weights were not kept by this step's assembly");
 		for (std::size_t s = 0; s < sets.size(); ++s) {
-			WaterPointSet&           P     = *sets[s];
+			WaterPointSet& P = *sets[s];
+			// the assembly of this step sized the fluxes and weights and no point came or went since: a
+			// mismatch is a bug, not a state to reset (zeroing would drop every point's carried flux silently)
+			if (track && (P.subscaleFlux.size() != P.size() || system.subscaleInstant[s].size() != P.size()))
+				throw std::logic_error("accumulatePressureForces: the water points' subscale fluxes were not sized by this step's assembly");
 			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
@@ -64,6 +43,14 @@ namespace stages {
 					n += N * fields.porosity[I];
 				});
 				if (storePointPressures) P.porePressure[p] = q; // S4a: p^{n+1} at the point, with the weights of t^n
+				if (track) {
+					const Real instant = system.subscaleInstant[s][p];
+					int        corner[3];
+					if (instant > 0 && cellCornerInStencil<S>(grid, P.position[p], w, corner)) {
+						P.subscaleFlux[p] = system.subscaleMemory[s][p] * P.subscaleFlux[p] - instant * (gradq - cellMeanGradient<S>(grid, w, corner, pressure));
+					} else
+						P.subscaleFlux[p].setZero();
+				}
 				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);
 				const Real V = P.volume[p];
 				forEachNode<Kernel>(grid, w, [&](std::size_t I, Real N, const Vec3& dN) {

@@ -1,7 +1,8 @@
 // Helpers shared by the pressure projection's sources (doc/theory.md §8): the stored rows' slots,
 // eq. 8.6b's fluctuation gradients, eq. 8.6c's subscale weights, the wet solid points' cut (eq. 8.1c),
 // the pressure forces' nodal increments with the walls' holds (eq. 8.8) and the free rows' solve.
-// Internal to the core: included by Pressure{Nodes,Assembly,Solve,Corrector}.cpp and CapillarySurface.cpp only.
+// Internal to the core: included by Pressure{Nodes,Assembly,Solve,Corrector}.cpp and CapillarySurface.cpp (and
+// tests/core/test_pressure_projection.cpp) only.
 #pragma once
 
 #include "PressureProjection.hpp"
@@ -61,6 +62,25 @@ namespace projection {
 					if (i >= 0 && i <= 1 && j >= 0 && j <= 1 && k >= 0 && k <= 1) G[c][b][a] -= centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
 				}
 		return true;
+	}
+
+	// Σ_J ∇N_J(x_c) p_J over the eight nodes of a point's cell (stencil corner `cellCorner`, from
+	// cellCornerInStencil), p per grid node: the cell's mean pressure gradient of eq. 8.6b, so that the
+	// point's Σ_J G_J p_J = Σ_J ∇S_J p_J − this (what fluctuationGradients' G sums to), from the pressure
+	// gradient the corrector's pass sums anyway.
+	template <int S>
+	inline Vec3 cellMeanGradient(const GridGeometry& grid, const Weights1D (&w)[3], const int (&cellCorner)[3], const std::vector<Real>& pressure)
+	{
+		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
+		int        node[3][S];
+		stencilNodes(grid, w, node);
+		Vec3 mean = Vec3::Zero();
+		for (int k = 0; k < 2; ++k)
+			for (int j = 0; j < 2; ++j)
+				for (int i = 0; i < 2; ++i)
+					mean += (centre * pressure[grid.index(node[0][cellCorner[0] + i], node[1][cellCorner[1] + j], node[2][cellCorner[2] + k])]) *
+					        Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
+		return mean;
 	}
 
 	// At one point of stencil `node`: the weight gradients ∇S_J (zero off the nodes it reaches), and the

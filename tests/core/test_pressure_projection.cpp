@@ -485,6 +485,46 @@ TEST(PressureSystem, LocalProjectionStabilisationIsZeroOnLinearFieldsAndSeesTheC
 	EXPECT_NEAR(energy(random), onRandom, 1e-10 * onRandom);
 }
 
+// Eq. 8.6c's update after the solve, as the corrector does it (in its water points' pass, from the
+// pressure gradient that pass sums less the cell's mean one, with the weights the assembly kept):
+// q′^{n+1} = memory q′^n − instant (∇p_wp − ∇p_hat(x_c)), instant = min(c κ/μw, Δt λ̄) and memory =
+// 1 − instant/(c κ/μw) from κ/μw and λ interpolated at the point, the departure by its definition
+// (fixtures::gradientDeparture) — the two are equal to round-off on random pressures and fluxes.
+TEST(PressureSystem, SubscaleFluxUpdateIsItsDefinition)
+{
+	RandomPressureScene scene(false);
+	const GridGeometry& grid   = scene.grid;
+	PressureSystem&     system = scene.system;
+	WaterPointSet&      fluid  = scene.fluid;
+	system.dynamicSubscales    = true;
+	stages::assemblePressureSystem<GimpKernel>(grid, scene.fields, scene.solids, scene.waters, scene.water, scene.held, scene.heldSolid, scene.dt, 1e-12, 1e-12, 1, system);
+	ASSERT_EQ(fluid.subscaleFlux.size(), fluid.size());
+	for (Vec3& q : fluid.subscaleFlux) q = 1e-4 * Vec3(scene.unit(scene.rng), scene.unit(scene.rng), scene.unit(scene.rng));
+	const std::vector<Vec3> before = fluid.subscaleFlux;
+	system.nodalPressure.assign(grid.nodeCount(), 0);
+	for (std::size_t I : system.node) system.nodalPressure[I] = 1e3 * scene.unit(scene.rng);
+	stages::correctVelocities<GimpKernel>(grid, scene.fields, scene.solids, scene.waters, BoundaryConditions {}, Vec3::Zero(), scene.water.density, scene.held,
+	                                      scene.heldSolid, scene.dt, 1e-12, 1e-12, system);
+	int updated = 0;
+	for (std::size_t p = 0; p < fluid.size(); ++p) {
+		const fixtures::GradientDeparture d = fixtures::gradientDeparture(grid, fluid.position[p], fluid.halfLength[p], system.darcyConductance, system.nodalPressure);
+		Weights1D w[3];
+		detail::weightsAt<GimpKernel>(grid, fluid.position[p], fluid.halfLength[p], w);
+		Vec3 lambda = Vec3::Zero();
+		for (int c = 0; c < 3; ++c)
+			for (int b = 0; b < 3; ++b)
+				for (int a = 0; a < 3; ++a) lambda += w[0].value[a] * w[1].value[b] * w[2].value[c] * system.mobility[grid.index(w[0].first + a, w[1].first + b, w[2].first + c)];
+		Vec3 expected = Vec3::Zero();
+		if (d.darcy > 0) {
+			const Real instant = std::min(d.darcy, scene.dt * lambda.mean());
+			expected           = (1 - instant / d.darcy) * before[p] - instant * d.departure;
+			++updated;
+		}
+		EXPECT_LE((fluid.subscaleFlux[p] - expected).norm(), 1e-10 * (before[p].norm() + expected.norm())) << "water point " << p;
+	}
+	EXPECT_GT(updated, static_cast<int>(fluid.size()) / 2); // the scene's points carry the skeleton's drag: most are updated, not zeroed
+}
+
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinition) { expectMatrixIsThePairSum(false); }
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionAcrossAPeriodicSeamOfThreeCells) { expectMatrixIsThePairSum(true); }
 TEST(PressureSystem, MatrixIsThePairSumOfItsDefinitionWithExtraPairsOutOfOrder) { expectMatrixIsThePairSum(false, true); }
