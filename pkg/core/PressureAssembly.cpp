@@ -113,7 +113,6 @@ namespace stages {
 		system.cellPoints.resize(start[nodes]);
 		for (std::size_t p = 0; p < P.size(); ++p)
 			if (cellKey[p] != none) system.cellPoints[start[cellKey[p]]++] = p;
-		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
 		auto       boxIndex = [](int a, int b, int c) { return a + U * (b + U * c); };
 		scatter(system.rows, system.rowBuffers, system.occupiedCellNode.size(), [&](std::size_t occupied, Real* rows) {
 			const std::array<int, 3> cell = grid.indices(system.occupiedCellNode[occupied]);
@@ -169,7 +168,7 @@ namespace stages {
 						const int ak = inner + i, bk = inner + j, ck = inner + k, lK = boxIndex(ak, bk, ck);
 						const int rowK = row[lK];
 						if (rowK < 0) continue;
-						const Vec3  HK = centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
+						const Vec3  HK = hatGradientAtCellCentre(grid, i, j, k);
 						const Vec3& DK = D[lK];
 						for (int c = boxLo[2]; c < boxHi[2]; ++c)
 							for (int b = boxLo[1]; b < boxHi[1]; ++b)
@@ -181,7 +180,7 @@ namespace stages {
 									if (cellJ && lJ > lK) continue; // two cell nodes: once, from the later one's turn
 									Real value = -D[lJ].dot(HK);
 									if (cellJ) {
-										const Vec3 HJ = centre * Vec3(2 * iJ - 1, 2 * jJ - 1, 2 * kJ - 1);
+										const Vec3 HJ = hatGradientAtCellCentre(grid, iJ, jJ, kJ);
 										value += W * HJ.dot(HK) - DK.dot(HJ);
 									}
 									if (lJ <= lK) rows[static_cast<std::size_t>(rowJ) * PressureSystem::rowStride + upperSlot(ak - a, bk - b, ck - c)] += value;
@@ -270,12 +269,11 @@ namespace stages {
 		assignInParallel<Real>(system.rows, system.node.size() * PressureSystem::rowStride, 0);
 		const Real invKw = 1 / water.bulkModulus; // 0 for incompressible water (Kw = ∞)
 		const bool keepSubscaleWeights = stabilised && system.dynamicSubscales; // for the update after the solve (accumulatePressureForces)
-		system.subscaleInstant.resize(keepSubscaleWeights ? sets.size() : 0);
-		system.subscaleMemory.resize(keepSubscaleWeights ? sets.size() : 0);
+		system.pointSubscaleWeights.resize(keepSubscaleWeights ? sets.size() : 0);
 		for (std::size_t s = 0; s < sets.size(); ++s) {
 			const WaterPointSet& P     = *sets[s];
 			system.fluctuationWeight.resize(P.size());
-			if (keepSubscaleWeights) system.subscaleInstant[s].resize(P.size()), system.subscaleMemory[s].resize(P.size());
+			if (keepSubscaleWeights) system.pointSubscaleWeights[s].resize(P.size());
 			scatter(system.rows, system.rowBuffers, P.size(), [&](std::size_t p, Real* rows) {
 				Weights1D w[3];
 				weightsAt<Kernel>(grid, P, p, w);
@@ -320,7 +318,7 @@ namespace stages {
 				if (system.dynamicSubscales) {
 					const SubscaleWeights sw = subscaleWeights(darcy, lambda, dt);
 					darcy = sw.instant, memory = sw.memory;
-					if (keepSubscaleWeights) system.subscaleInstant[s][p] = sw.instant, system.subscaleMemory[s][p] = sw.memory;
+					if (keepSubscaleWeights) system.pointSubscaleWeights[s][p] = sw;
 				}
 				if (darcy > 0) conductance += Vec3::Constant(V * darcy);
 				const Real stored      = storage * P.porePressure[p]; // C p^n/Δt with the point's p^n

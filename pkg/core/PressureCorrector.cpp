@@ -24,13 +24,13 @@ namespace stages {
 		// water points' pass below: Σ_J G_J p_J = Σ_J ∇S_J p_J − Σ_{J of the cell} ∇N_J(x_c) p_J, the pressure
 		// gradient the pass sums anyway less the cell's mean one
 		const bool track = storePointPressures && system.dynamicSubscales && !system.darcyConductance.empty();
-		if (track && system.subscaleInstant.size() != sets.size())
+		if (track && system.pointSubscaleWeights.size() != sets.size())
 			throw std::logic_error("accumulatePressureForces: the subscale weights were not kept by this step's assembly");
 		for (std::size_t s = 0; s < sets.size(); ++s) {
 			WaterPointSet& P = *sets[s];
 			// the assembly of this step sized the fluxes and weights and no point came or went since: a
 			// mismatch is a bug, not a state to reset (zeroing would drop every point's carried flux silently)
-			if (track && (P.subscaleFlux.size() != P.size() || system.subscaleInstant[s].size() != P.size()))
+			if (track && (P.subscaleFlux.size() != P.size() || system.pointSubscaleWeights[s].size() != P.size()))
 				throw std::logic_error("accumulatePressureForces: the water points' subscale fluxes were not sized by this step's assembly");
 			scatter(system.forces, system.forceBuffers, P.size(), [&](std::size_t p, PressureForceNode* nodes) {
 				Weights1D w[3];
@@ -44,11 +44,11 @@ namespace stages {
 				});
 				if (storePointPressures) P.porePressure[p] = q; // S4a: p^{n+1} at the point, with the weights of t^n
 				if (track) {
-					const Real instant = system.subscaleInstant[s][p];
-					int        corner[3];
-					if (instant > 0 && cellCornerInStencil<S>(grid, P.position[p], w, corner)) {
-						P.subscaleFlux[p] = system.subscaleMemory[s][p] * P.subscaleFlux[p] - instant * (gradq - cellMeanGradient<S>(grid, w, corner, pressure));
-					} else
+					const SubscaleWeights& sw = system.pointSubscaleWeights[s][p];
+					int                    corner[3];
+					if (sw.instant > 0 && cellCornerInStencil<S>(grid, P.position[p], w, corner))
+						P.subscaleFlux[p] = sw.memory * P.subscaleFlux[p] - sw.instant * (gradq - cellMeanGradient<S>(grid, w, corner, pressure));
+					else
 						P.subscaleFlux[p].setZero();
 				}
 				n            = std::clamp<Real>(n, minimumInterpolatedPorosity, 1);

@@ -58,6 +58,13 @@ struct PressureWork {
 	Real scale   = 0; // Σ_I |g^s_I||u^s_I| + |g^w_I||u^w_I|: the size the two are compared at [W]
 };
 
+// Eq. 8.6c's weights at one water point: the weight of S this step, the flux's instantaneous response
+// min(κ/μw, Δt λ̄) [m² Pa⁻¹ s⁻¹], and the share 1 − that/(κ/μw) of the last step's subscale flux that its
+// inertia keeps against the drag [-].
+struct SubscaleWeights {
+	Real instant = 0, memory = 0;
+};
+
 // The grid-node system of eq. 8.7 and its scratch, reused from step to step.
 struct PressureSystem {
 	// One row of K in stencil form: of the offsets (−2..2)³ between two nodes that share a point, the
@@ -92,7 +99,7 @@ struct PressureSystem {
 	std::vector<Vec3>        mobility;        // per grid node and axis: λ of eq. 8.5 with the walls' holds [m³ kg⁻¹]
 	bool                     dynamicSubscales = false; // eq. 8.6c: S with the instantaneous weight and each water point's subscale flux carried from step to step
 	Real                     subscaleStep     = 0;     // Δt of the assembly (eq. 8.6c's update after the solve) [s]
-	std::vector<std::vector<Real>> subscaleInstant, subscaleMemory; // per water point set and point: eq. 8.6c's weights as the assembly computed them, for the update after the solve (sized with the dynamic subscales and c > 0 only) [m² Pa⁻¹ s⁻¹], [-]
+	std::vector<std::vector<SubscaleWeights>> pointSubscaleWeights; // per water point set and point: eq. 8.6c's weights as the assembly computed them, for the update after the solve (empty without the dynamic subscales or with c = 0)
 	std::vector<Real>        darcyConductance; // per grid node: c κ/μw of eq. 8.6b where the skeleton has mass, else 0; empty when c = 0 [m² Pa⁻¹ s⁻¹]
 	std::vector<Real>        skeletonShare;      // per grid node: θ = min(1, V_I/V^w_I), 1 without water, 0 without skeleton (eq. 8.1) [-]
 	std::vector<Real>        skeletonWetting;    // per grid node: min(1, V^w_I/V_I), 0 without skeleton (eq. 8.1c) [-]

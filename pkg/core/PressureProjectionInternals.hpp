@@ -37,6 +37,13 @@ namespace projection {
 		return true;
 	}
 
+	// ∇N_J(x_c) of the trilinear hat of the cell's node (i, j, k) ∈ {0, 1}³ at the cell's centre x_c:
+	// ±1/(4h) per axis, eq. 8.6b's cell-mean gradient weights.
+	inline Vec3 hatGradientAtCellCentre(const GridGeometry& grid, int i, int j, int k)
+	{
+		return (1 / (4 * grid.cellSize)) * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
+	}
+
 	// The local projection stabilisation of eq. 8.6b at one point: G_J = ∇S_J(x_p) − ∇N_J(x_c), the
 	// gradient of node J's weight at the point less that of its trilinear hat at the centre x_c of the
 	// point's cell (zero off the cell's eight nodes), so that Σ_J G_J p_J is the part of the point's
@@ -53,13 +60,12 @@ namespace projection {
 		int reachedLo[3], reachedHi[3];
 		reachedNodes<S>(w, reachedLo, reachedHi);
 		for (int d = 0; d < 3; ++d) lo[d] = std::min(reachedLo[d], cellCorner[d]), hi[d] = std::max(reachedHi[d], cellCorner[d] + 2);
-		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
 		for (int c = lo[2]; c < hi[2]; ++c)
 			for (int b = lo[1]; b < hi[1]; ++b)
 				for (int a = lo[0]; a < hi[0]; ++a) {
 					G[c][b][a]  = dN[c][b][a];
 					const int i = a - cellCorner[0], j = b - cellCorner[1], k = c - cellCorner[2];
-					if (i >= 0 && i <= 1 && j >= 0 && j <= 1 && k >= 0 && k <= 1) G[c][b][a] -= centre * Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
+					if (i >= 0 && i <= 1 && j >= 0 && j <= 1 && k >= 0 && k <= 1) G[c][b][a] -= hatGradientAtCellCentre(grid, i, j, k);
 				}
 		return true;
 	}
@@ -71,15 +77,13 @@ namespace projection {
 	template <int S>
 	inline Vec3 cellMeanGradient(const GridGeometry& grid, const Weights1D (&w)[3], const int (&cellCorner)[3], const std::vector<Real>& pressure)
 	{
-		const Real centre = 1 / (4 * grid.cellSize); // |∂N/∂x| of a trilinear hat at its cell's centre
-		int        node[3][S];
+		int node[3][S];
 		stencilNodes(grid, w, node);
 		Vec3 mean = Vec3::Zero();
 		for (int k = 0; k < 2; ++k)
 			for (int j = 0; j < 2; ++j)
 				for (int i = 0; i < 2; ++i)
-					mean += (centre * pressure[grid.index(node[0][cellCorner[0] + i], node[1][cellCorner[1] + j], node[2][cellCorner[2] + k])]) *
-					        Vec3(2 * i - 1, 2 * j - 1, 2 * k - 1);
+					mean += pressure[grid.index(node[0][cellCorner[0] + i], node[1][cellCorner[1] + j], node[2][cellCorner[2] + k])] * hatGradientAtCellCentre(grid, i, j, k);
 		return mean;
 	}
 
@@ -108,12 +112,8 @@ namespace projection {
 				}
 	}
 
-	// Eq. 8.6c at one water point from its interpolated κ/μw (`darcy`) and mobility λ: the weight of S
-	// this step, the flux's instantaneous response min(κ/μw, Δt λ̄) (λ̄ the mean over the axes), and the
-	// share 1 − that/κ/μw of the last step's subscale flux that its inertia keeps against the drag
-	struct SubscaleWeights {
-		Real instant = 0, memory = 0;
-	};
+	// Eq. 8.6c at one water point from its interpolated κ/μw (`darcy`) and mobility λ (SubscaleWeights,
+	// PressureProjection.hpp; λ̄ the mean over the axes)
 	inline SubscaleWeights subscaleWeights(Real darcy, const Vec3& lambda, Real dt)
 	{
 		if (!(darcy > 0)) return {};
